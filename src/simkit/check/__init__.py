@@ -1,0 +1,33 @@
+"""The check stage: read a written kit the way a user would and compare everything.
+
+`run_checks` is what `simkit build` runs on its staging folder and `simkit check` on any kit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from simkit.check.findings import Finding
+from simkit.check.kit import Kit
+from simkit.check.mujoco_check import check_hold, check_models
+from simkit.check.published import check_published
+from simkit.check.urdf_check import check_urdf
+
+Check = Callable[[Kit], list[Finding]]
+
+CHECKS: dict[str, Check] = {
+    "published": check_published,
+    "models": check_models,
+    "urdf": check_urdf,
+    "hold": check_hold,
+}
+
+
+def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Finding]:
+    """Every finding for the kit at `kit_dir`, in a stable order."""
+    kit = Kit.open(kit_dir)
+    findings: list[Finding] = []
+    for check in (checks or CHECKS).values():
+        findings.extend(check(kit))
+    return findings

@@ -1,0 +1,79 @@
+"""A written kit as a user sees it: robot.json plus file paths, and FK from robot.json alone."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from simkit.errors import SimkitError
+from simkit.kinematics import axis_angle, rpy_matrix, transform
+
+
+@dataclass(frozen=True)
+class Kit:
+    """A kit folder on disk."""
+
+    root: Path
+
+    @staticmethod
+    def open(path: Path) -> Kit:
+        if not (path / "robot.json").is_file():
+            raise SimkitError(f"{path}: not a kit folder (no robot.json)")
+        return Kit(path)
+
+    def path(self, relative: str) -> Path:
+        return self.root / relative
+
+    @cached_property
+    def doc(self) -> dict:
+        return json.loads((self.root / "robot.json").read_text(encoding="utf-8"))
+
+    @property
+    def name(self) -> str:
+        return self.doc["name"]
+
+    @property
+    def urdf(self) -> str:
+        return self.doc["files"]["urdf"]
+
+    @property
+    def mjcf(self) -> str:
+        return self.doc["files"]["mjcf"]
+
+    @property
+    def joints(self) -> list[dict]:
+        return self.doc["joints"]
+
+    @property
+    def base_frame(self) -> str:
+        return self.doc["base_frame"]
+
+    def fk(self, q, target: str | None = None) -> np.ndarray:
+        """T_base_target from robot.json's joints (movable and fixed) and frames."""
+        target = target or self.doc["tool_frame"]
+        values = dict(zip([j["name"] for j in self.joints], q, strict=True))
+        by_child = {j["child"]: j for j in self.joints + self.doc["fixed_joints"]}
+        frame = self.doc["frames"].get(target)
+        tail = np.eye(4)
+        node = target
+        if target not in by_child and frame is not None and "parent" in frame:
+            tail = transform(frame["xyz"], rpy_matrix(frame["rpy"]))
+            node = frame["parent"]
+        chain = []
+        while node != self.base_frame:
+            joint = by_child[node]
+            chain.append(joint)
+            node = joint["parent"]
+        out = np.eye(4)
+        for joint in reversed(chain):
+            out = out @ transform(joint["origin_xyz"], rpy_matrix(joint["origin_rpy"]))
+            if joint["name"] in values:
+                if joint["type"] == "prismatic":
+                    out = out @ transform(np.asarray(joint["axis"]) * values[joint["name"]])
+                else:
+                    out = out @ transform((0, 0, 0), axis_angle(joint["axis"], values[joint["name"]]))
+        return out @ tail

@@ -1,0 +1,155 @@
+"""Checks that load the written URDF and MJCF in MuJoCo and compare them with each other,
+with robot.json, and with the published numbers."""
+
+from __future__ import annotations
+
+import re
+import mujoco
+import numpy as np
+
+from simkit.check.findings import Finding, compare, require
+from simkit.check.kit import Kit
+
+N_RANDOM = 25
+HOLD_SECONDS = 2.0
+HOLD_TOLERANCE_DEG = 0.5  # kit page: "a held pose sits within a few tenths of a degree"
+
+
+def load_mjcf(kit: Kit) -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_path(str(kit.path(kit.mjcf)))
+
+
+def load_urdf_in_mujoco(kit: Kit) -> mujoco.MjModel:
+    """Compile the URDF in MuJoCo, keeping fixed frames as bodies and the relative mesh paths
+    (MuJoCo's URDF reader strips directories unless told not to)."""
+    text = kit.path(kit.urdf).read_text(encoding="utf-8")
+    ext = '<mujoco><compiler strippath="false" fusestatic="false" discardvisual="true"/></mujoco>'
+    text = re.sub(r"(<robot\b[^>]*>)", r"\1" + ext, text, count=1)
+    tmp = kit.path(kit.urdf).with_name(".simkit_check.urdf")
+    tmp.write_text(text, encoding="utf-8")
+    try:
+        return mujoco.MjModel.from_xml_path(str(tmp))
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _qpos_indices(model: mujoco.MjModel, names: list[str]) -> list[int]:
+    return [int(model.jnt_qposadr[model.joint(n).id]) for n in names]
+
+
+def _dof_indices(model: mujoco.MjModel, names: list[str]) -> list[int]:
+    return [int(model.jnt_dofadr[model.joint(n).id]) for n in names]
+
+
+def random_configs(kit: Kit, count: int, seed: int = 0) -> np.ndarray:
+    """Seeded random joint positions within limits (continuous joints: +-pi)."""
+    rng = np.random.default_rng(seed)
+    lower = np.array([j["lower"] if j["lower"] is not None else -np.pi for j in kit.joints])
+    upper = np.array([j["upper"] if j["upper"] is not None else np.pi for j in kit.joints])
+    return rng.uniform(lower, upper, size=(count, len(lower)))
+
+
+def check_models(kit: Kit) -> list[Finding]:
+    """Compile both files; compare masses, tool FK and gravity torques between them."""
+    findings: list[Finding] = []
+    try:
+        mj = load_mjcf(kit)
+        findings.append(require("mjcf.compile", True, f"{kit.mjcf} compiles in MuJoCo {mujoco.__version__}"))
+    except Exception as exc:  # MuJoCo raises ValueError with the compiler's message
+        return [require("mjcf.compile", False, f"{kit.mjcf}: {exc}")]
+    try:
+        ur = load_urdf_in_mujoco(kit)
+        findings.append(require("urdf.compile", True, f"{kit.urdf} compiles in MuJoCo"))
+    except Exception as exc:
+        return [*findings, require("urdf.compile", False, f"{kit.urdf}: {exc}")]
+
+    links = [link["name"] for link in kit.doc["links"]]
+    mass_json = [link["mass"] for link in kit.doc["links"]]
+    mass_mj = [float(mj.body_mass[mj.body(n).id]) for n in links]
+    mass_ur = [float(ur.body_mass[ur.body(n).id]) for n in links]
+    findings.append(compare("mass.mjcf", "per-link mass, MJCF vs robot.json", mass_json, mass_mj, 1e-6, "kg"))
+    findings.append(compare("mass.urdf", "per-link mass, URDF vs robot.json", mass_json, mass_ur, 1e-6, "kg"))
+    inertia_mj = [mj.body_inertia[mj.body(n).id] for n in links]
+    inertia_ur = [ur.body_inertia[ur.body(n).id] for n in links]
+    findings.append(compare("inertia.urdf_vs_mjcf", "principal inertia per link", inertia_mj,
+                            inertia_ur, 1e-7, "kg m^2"))
+
+    names = [j["name"] for j in kit.joints]
+    configs = random_configs(kit, N_RANDOM)
+    tool = kit.doc["tool_frame"] if "tool_frame" in kit.doc else None
+    dmj, dur = mujoco.MjData(mj), mujoco.MjData(ur)
+    qa, qb = _qpos_indices(mj, names), _qpos_indices(ur, names)
+    va, vb = _dof_indices(mj, names), _dof_indices(ur, names)
+    pos_mj, pos_ur, pos_json, tau_mj, tau_ur = [], [], [], [], []
+    for q in configs:
+        dmj.qpos[qa], dur.qpos[qb] = q, q
+        mujoco.mj_forward(mj, dmj)
+        mujoco.mj_forward(ur, dur)
+        tau_mj.append(dmj.qfrc_bias[va].copy())
+        tau_ur.append(dur.qfrc_bias[vb].copy())
+        if tool:
+            base = kit.base_frame
+            T_w_base_mj = _body_pose(mj, dmj, base)
+            T_w_base_ur = _body_pose(ur, dur, base)
+            pos_mj.append((np.linalg.inv(T_w_base_mj) @ _site_or_body_pose(mj, dmj, tool))[:3, 3])
+            pos_ur.append((np.linalg.inv(T_w_base_ur) @ _body_pose(ur, dur, tool))[:3, 3])
+            pos_json.append(kit.fk(q)[:3, 3])
+    if tool:
+        findings.append(compare("fk.mjcf_vs_robot_json", f"{tool} at {N_RANDOM} random configurations",
+                                pos_json, pos_mj, 1e-6, "m"))
+        findings.append(compare("fk.urdf_vs_mjcf", f"{tool} at {N_RANDOM} random configurations",
+                                pos_mj, pos_ur, 1e-6, "m"))
+    scale = max(1.0, float(np.abs(tau_mj).max()))
+    findings.append(compare("gravity.urdf_vs_mjcf", f"gravity torques at {N_RANDOM} random "
+                            "configurations", np.array(tau_mj) / scale, np.array(tau_ur) / scale,
+                            1e-6, "x max torque"))
+    return findings
+
+
+def _body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
+    out = np.eye(4)
+    if name in ("world",) or mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) < 0:
+        return out
+    body = data.body(name)
+    out[:3, :3] = body.xmat.reshape(3, 3)
+    out[:3, 3] = body.xpos
+    return out
+
+
+def _site_or_body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
+    if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:
+        site = data.site(name)
+        out = np.eye(4)
+        out[:3, :3] = site.xmat.reshape(3, 3)
+        out[:3, 3] = site.xpos
+        return out
+    return _body_pose(model, data, name)
+
+
+def check_hold(kit: Kit) -> list[Finding]:
+    """Position servos hold each named pose under gravity within a few tenths of a degree,
+    with no contact between the robot's own links on the way."""
+    mj = load_mjcf(kit)
+    if mj.nu == 0:
+        return []
+    names = [j["name"] for j in kit.joints]
+    acts = [mj.actuator(i).name for i in range(mj.nu)]
+    qa = _qpos_indices(mj, names)
+    findings = []
+    for pose, q in kit.doc["poses"].items():
+        data = mujoco.MjData(mj)
+        data.qpos[qa] = q
+        for name, value in zip(names, q, strict=True):
+            if name in acts:
+                data.ctrl[mj.actuator(name).id] = value
+        mujoco.mj_forward(mj, data)
+        contacts = int(data.ncon)
+        steps = int(round(HOLD_SECONDS / mj.opt.timestep))
+        for _ in range(steps):
+            mujoco.mj_step(mj, data)
+        error = np.degrees(np.abs(data.qpos[qa] - np.asarray(q)))
+        findings.append(compare("hold." + pose, f"servos hold '{pose}' for {HOLD_SECONDS:g} s",
+                                np.zeros_like(error), error, HOLD_TOLERANCE_DEG, "deg"))
+        findings.append(require("contact." + pose, contacts == 0,
+                                f"self-contacts at '{pose}': {contacts}"))
+    return findings

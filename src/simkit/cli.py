@@ -1,0 +1,86 @@
+"""The `simkit` command line. Thin: parse, call the library, turn errors into one line."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+from rich.console import Console
+
+from simkit import __version__
+from simkit.errors import SimkitError
+
+err = Console(stderr=True, highlight=False, soft_wrap=True)
+out = Console(highlight=False, soft_wrap=True)
+
+
+def _fail(exc: SimkitError) -> None:
+    err.print(f"simkit: error: {exc}", markup=False)
+    sys.exit(exc.exit_code)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="simkit")
+def main() -> None:
+    """Turn robot specs into complete, checked simulation kits."""
+
+
+@main.command()
+@click.argument("targets", nargs=-1, required=True)
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("build"), show_default=True, help="Folder for kits and zips.")
+@click.option("--no-check", is_flag=True, help="Skip the check stage (not recommended).")
+@click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
+def build(targets: tuple[str, ...], out_dir: Path, no_check: bool, quiet: bool) -> None:
+    """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
+    from simkit.build import build as run_build
+
+    for target in targets:
+        def progress(msg: str, _t: str = target) -> None:
+            if not quiet:
+                err.print(f"[{_t}] {msg}", markup=False)
+
+        try:
+            result = run_build(target, out_dir, check=not no_check, progress=progress)
+        except SimkitError as exc:
+            _fail(exc)
+        passed = sum(f.ok for f in result.findings)
+        out.print(f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
+                  f"{result.zip_path}; {passed}/{len(result.findings)} checks passed", markup=False)
+
+
+@main.command()
+@click.argument("kit_dir", type=click.Path(path_type=Path))
+@click.option("-v", "--verbose", is_flag=True, help="Print every finding, not only failures.")
+def check(kit_dir: Path, verbose: bool) -> None:
+    """Run the checks on a built kit folder."""
+    from simkit.check import run_checks
+    from simkit.errors import CheckFailed
+
+    try:
+        if not kit_dir.is_dir():
+            raise SimkitError(f"{kit_dir}: no such kit folder")
+        findings = run_checks(kit_dir)
+    except SimkitError as exc:
+        _fail(exc)
+    failed = [f for f in findings if not f.ok]
+    for finding in findings:
+        if verbose or not finding.ok:
+            out.print(finding.line(), markup=False)
+    out.print(f"{len(findings) - len(failed)} passed, {len(failed)} failed", markup=False)
+    if failed:
+        sys.exit(CheckFailed.exit_code)
+
+
+@main.command(name="list")
+def list_robots() -> None:
+    """List the robots simkit ships specs for."""
+    from simkit.resources import robot_names
+
+    for name in robot_names():
+        out.print(name, markup=False)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

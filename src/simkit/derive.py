@@ -1,0 +1,71 @@
+"""Derive steps: pure functions Robot -> Robot (solids, mass properties, servos, references)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from simkit import dynamics, massprops, solids
+from simkit.kinematics import forward
+from simkit.model import Robot
+
+
+def derive_solids(robot: Robot, base_dir: Path) -> Robot:
+    """Fill each link's visual solid from its primitives."""
+    links = tuple(
+        replace(link, solid=solids.link_solid(link.shapes, base_dir)) if link.shapes else link
+        for link in robot.links
+    )
+    return replace(robot, links=links)
+
+
+def derive_mass(robot: Robot) -> Robot:
+    """CoM and inertia from the solid scaled to the link mass, unless the spec gives them."""
+    links = tuple(
+        link if link.inertial is not None else replace(link, inertial=massprops.from_solid(link.solid, link.mass))
+        for link in robot.links
+    )
+    return replace(robot, links=links)
+
+
+def _distance_from_axis(point: np.ndarray, origin: np.ndarray, axis: np.ndarray) -> float:
+    r = point - origin
+    return float(np.linalg.norm(r - axis * (axis @ r)))
+
+
+def derive_references(robot: Robot) -> Robot:
+    """FK reference poses (wrist centre, tool pose in the first link's frame) and reach."""
+    movable = robot.movable_joints
+    base = movable[0].parent if movable else robot.root
+    tool = robot.tool_frame
+    fk_reference = []
+    for name, q in robot.poses:
+        poses = forward(robot, q)
+        inv = np.linalg.inv(poses[base])
+        entry: dict = {"pose": name, "q": list(q)}
+        if robot.wrist_centre:
+            entry["wrist_centre"] = list((inv @ poses[robot.wrist_centre])[:3, 3])
+        if tool:
+            t = inv @ poses[tool]
+            entry[tool] = {"xyz": list(t[:3, 3]), "rotation": t[:3, :3].tolist()}
+        fk_reference.append(entry)
+    derived = dict(robot.derived, fk_reference=fk_reference, base_frame=base)
+    if "stretched" in dict(robot.poses) and movable and robot.wrist_centre and tool:
+        poses = forward(robot, robot.pose("stretched"))
+        first = poses[movable[0].child]
+        origin, axis = first[:3, 3], first[:3, :3] @ np.asarray(movable[0].axis)
+        derived["reach_geometric"] = {
+            "wrist": _distance_from_axis(poses[robot.wrist_centre][:3, 3], origin, axis),
+            "flange": _distance_from_axis(poses[tool][:3, 3], origin, axis),
+        }
+    return replace(robot, derived=derived)
+
+
+def derive_all(robot: Robot, base_dir: Path) -> Robot:
+    """All derive steps in order."""
+    robot = derive_solids(robot, base_dir)
+    robot = derive_mass(robot)
+    robot = dynamics.derive_actuators(robot)
+    return derive_references(robot)

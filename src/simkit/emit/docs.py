@@ -1,0 +1,78 @@
+"""Kit README.md and LICENSE.txt from Jinja templates; values arrive already formatted."""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+
+import jinja2
+
+from simkit import layout
+from simkit.fmt import num
+from simkit.model import Robot
+from simkit.resources import data_dir
+
+
+@cache
+def environment() -> jinja2.Environment:
+    """The template environment shared by every text emitter."""
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
+        undefined=jinja2.StrictUndefined,
+        keep_trailing_newline=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        autoescape=False,
+    )
+
+
+def _deg(value: float | None) -> str:
+    return "" if value is None else num(math.degrees(value), 4)
+
+
+def context(robot: Robot) -> dict:
+    """Formatted values for the README template."""
+    axes = {(1.0, 0.0, 0.0): "x", (0.0, 1.0, 0.0): "y", (0.0, 0.0, 1.0): "z"}
+    joints = [
+        {
+            "name": j.name,
+            "parent": j.parent,
+            "child": j.child,
+            "axis": axes.get(tuple(j.axis), " ".join(num(a, 5) for a in j.axis)),
+            "lower": _deg(j.lower),
+            "upper": _deg(j.upper),
+            "velocity": _deg(j.max_velocity),
+            "effort_peak": num(j.effort_peak, 4) if j.effort_peak else "",
+            "drive_peak": num(j.drive_peak_torque_at_joint, 4) if j.drive_peak_torque_at_joint else "",
+            "armature": num(j.armature, 4),
+        }
+        for j in robot.movable_joints
+    ]
+    poses = {name: ", ".join(num(math.degrees(v), 4) for v in q) for name, q in robot.poses}
+    demo = [num(v, 4) for v in dict(robot.poses).get("work", ())]
+    return {
+        "robot": robot.name,
+        "title": robot.title,
+        "description": robot.description,
+        "package": layout.kit_dir_name(robot.name),
+        "urdf": layout.urdf(robot.name),
+        "mjcf": layout.mjcf(robot.name),
+        "joints": joints,
+        "poses": poses,
+        "mass": num(robot.total_mass, 4),
+        "root": robot.root,
+        "tool": robot.tool_frame or "",
+        "n_movable": len(robot.movable_joints),
+        "has_actuators": bool(robot.actuators),
+        "demo_q": demo,
+        "sources": list(robot.sources),
+    }
+
+
+def emit(robot: Robot) -> dict[str, bytes]:
+    """`README.md` and `LICENSE.txt`."""
+    env, ctx = environment(), context(robot)
+    return {
+        layout.README: env.get_template("kit_README.md.j2").render(ctx).encode("utf-8"),
+        layout.LICENSE: env.get_template("LICENSE.txt.j2").render(ctx).encode("utf-8"),
+    }

@@ -1,0 +1,18 @@
+"""Mesh emitter: one visual STL per link and the collision pieces, link frame, metres."""
+
+from __future__ import annotations
+
+from simkit import layout
+from simkit.model import Robot
+from simkit.stl import to_stl
+
+
+def emit(robot: Robot) -> dict[str, bytes]:
+    """`meshes/visual/LINK.stl` and `meshes/collision/LINK_NN.stl`."""
+    out: dict[str, bytes] = {}
+    for link in robot.links:
+        if link.solid is not None:
+            out[layout.visual_mesh(link.name)] = to_stl(link.solid, link.name)
+        for i, piece in enumerate(link.collision):
+            out[layout.collision_mesh(link.name, i)] = to_stl(piece, f"{link.name}_{i:02d}")
+    return out

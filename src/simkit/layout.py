@@ -1,0 +1,65 @@
+"""Every path inside a kit comes from here, so no two outputs can disagree about a path.
+
+Paths are POSIX, relative to the kit folder `NAME_description/`.
+"""
+
+from __future__ import annotations
+
+import posixpath
+
+
+def kit_dir_name(robot: str) -> str:
+    """`rosie_1000` -> `rosie_1000_description` (also the ROS 2 package name)."""
+    return f"{robot}_description"
+
+
+def zip_name(robot: str) -> str:
+    """`rosie_1000` -> `rosie-1000-sim-kit.zip`, as the kit page's download link."""
+    return f"{robot.replace('_', '-')}-sim-kit.zip"
+
+
+README = "README.md"
+LICENSE = "LICENSE.txt"
+ROBOT_JSON = "robot.json"
+IK_CASES = "ik_cases.json"
+
+
+def urdf(robot: str) -> str:
+    return f"urdf/{robot}.urdf"
+
+
+def mjcf(robot: str) -> str:
+    return f"mjcf/{robot}.xml"
+
+
+def mjcf_scene(robot: str) -> str:
+    return f"mjcf/{robot}_scene.xml"
+
+
+def srdf(robot: str) -> str:
+    return f"srdf/{robot}.srdf"
+
+
+def glb(robot: str) -> str:
+    return f"glb/{robot}.glb"
+
+
+def usd(robot: str, binary: bool = False) -> str:
+    return f"usd/{robot}.{'usdc' if binary else 'usda'}"
+
+
+def visual_mesh(link: str) -> str:
+    return f"meshes/visual/{link}.stl"
+
+
+def collision_mesh(link: str, index: int) -> str:
+    return f"meshes/collision/{link}_{index:02d}.stl"
+
+
+def benchmark(robot: str, ext: str) -> str:
+    return f"benchmark/{robot}_cycle_1kg.{ext}"
+
+
+def relative(from_file: str, to_file: str) -> str:
+    """Path of `to_file` as seen from the folder of `from_file` (e.g. `../meshes/...`)."""
+    return posixpath.relpath(to_file, posixpath.dirname(from_file) or ".")
