@@ -1,0 +1,89 @@
+"""Pipeline behaviour: atomic publish, the check command, and the CLI's listing."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from simkit.build import build
+from simkit.check import run_checks
+from simkit.errors import CheckFailed
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _digest_tree(root: Path) -> dict[str, str]:
+    return {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_failed_build_keeps_previous_kit(rosie_1000, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    shutil.copytree(rosie_1000.kit_dir, out / rosie_1000.kit_dir.name)
+    shutil.copy(rosie_1000.zip_path, out / rosie_1000.zip_path.name)
+    before = _digest_tree(out)
+    # a spec that validates but whose published mass disagrees with its links: the check fails
+    spec = tmp_path / "rosie_1000.yaml"
+    spec.write_text((REPO / "robots/rosie_1000.yaml").read_text().replace(
+        "mass: 38.6                  # kg", "mass: 40.0                  # kg"))
+    with pytest.raises(CheckFailed, match="published.mass"):
+        build(str(spec), out)
+    assert _digest_tree(out) == before
+    assert sorted(p.name for p in out.iterdir()) == [rosie_1000.zip_path.name,
+                                                     rosie_1000.kit_dir.name]
+
+
+def test_check_passes_on_built_kit_and_fails_on_tampered_copy(rosie_1000, tmp_path):
+    assert all(f.ok for f in run_checks(rosie_1000.kit_dir))
+    copy = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, copy)
+    mjcf = copy / "mjcf/rosie_1000.xml"
+    mjcf.write_text(mjcf.read_text().replace('mass="10.4"', 'mass="11.4"', 1))
+    failed = {f.check for f in run_checks(copy) if not f.ok}
+    assert "mass.mjcf" in failed
+    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "check", str(copy)],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 3
+    assert "FAIL mass.mjcf" in proc.stdout and "expected" in proc.stdout
+
+
+def test_kit_layout_and_zip(rosie_1000):
+    kit = rosie_1000.kit_dir
+    assert kit.name == "rosie_1000_description"
+    assert rosie_1000.zip_path.name == "rosie-1000-sim-kit.zip"
+    for rel in ("README.md", "LICENSE.txt", "robot.json", "urdf/rosie_1000.urdf",
+                "mjcf/rosie_1000.xml", "meshes/visual/link_3.stl"):
+        assert (kit / rel).is_file(), rel
+    import zipfile
+
+    with zipfile.ZipFile(rosie_1000.zip_path) as archive:
+        names = archive.namelist()
+        assert names == sorted(names)
+        assert all(n.startswith("rosie_1000_description/") for n in names)
+        assert all(i.date_time == (1980, 1, 1, 0, 0, 0) for i in archive.infolist())
+        assert archive.read("rosie_1000_description/robot.json") == (kit / "robot.json").read_bytes()
+    doc = json.loads((kit / "robot.json").read_text())
+    assert "/" not in doc["provenance"]["spec"].split("robots/")[0]  # no absolute paths
+
+
+def test_cli_list_and_version():
+    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "list"], capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 0
+    names = proc.stdout.split()
+    assert {"rosie_600", "rosie_1000", "rosie_1400"} <= set(names)
+    assert names == sorted(names)
+
+
+def test_check_on_missing_folder_is_one_line(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "check", str(tmp_path / "nope")],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode != 0
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr

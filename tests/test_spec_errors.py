@@ -1,0 +1,114 @@
+"""A user's spec mistakes: one line naming file, line and field; non-zero exit; no traceback;
+no output folder left behind."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from simkit.errors import SpecError
+from simkit.validate import load_spec
+from simkit.yamlsource import load_yaml
+
+REPO = Path(__file__).resolve().parents[1]
+GOOD = (REPO / "robots" / "rosie_1000.yaml").read_text()
+
+
+def _variant(tmp_path: Path, old: str, new: str, count: int = 1) -> Path:
+    assert old in GOOD, old
+    path = tmp_path / "bad.yaml"
+    path.write_text(GOOD.replace(old, new, count))
+    return path
+
+
+def _line_of(path: Path, needle: str) -> int:
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
+        if needle in line:
+            return number
+    raise AssertionError(needle)
+
+
+CASES = [
+    ("negative mass", "    mass: 7.2\n", "    mass: -7.2\n", "mass: -7.2", "links[1].mass", "mass must be > 0"),
+    ("lower > upper", "    lower_deg: -135\n", "    lower_deg: 170\n", "lower_deg: 170", "joints[2].lower_deg",
+     "greater than upper"),
+    ("unknown parent", "    parent: link_4\n", "    parent: link_44\n", "parent: link_44",
+     "joints[5].parent", "unknown parent link 'link_44'"),
+    ("inertia not positive definite", "    mass: 2.9\n",
+     "    mass: 2.9\n    com: [0, 0, 0]\n    inertia: {ixx: 0.01, iyy: 0.01, izz: -0.01}\n",
+     "inertia: {ixx", "links[5].inertia", "not positive definite"),
+    ("inertia breaks triangle inequality", "    mass: 2.9\n",
+     "    mass: 2.9\n    com: [0, 0, 0]\n    inertia: {ixx: 0.001, iyy: 0.001, izz: 0.01}\n",
+     "inertia: {ixx", "links[5].inertia", "triangle inequality"),
+    ("unknown field", "    material: flange_steel\n", "    material: flange_steel\n    colour: red\n",
+     "colour: red", "links[6].colour", "unknown field"),
+    ("malformed YAML", "  - name: joint_3\n", "  - name: joint_3\n   bad: [1, 2\n", "bad: [1, 2",
+     "<yaml>", "malformed YAML"),
+]
+
+
+@pytest.mark.parametrize(("label", "old", "new", "needle", "field", "message"), CASES,
+                         ids=[c[0] for c in CASES])
+def test_library_reports_file_line_field(tmp_path, label, old, new, needle, field, message):
+    path = _variant(tmp_path, old, new)
+    with pytest.raises(SpecError) as info:
+        load_spec(path)
+    err = info.value
+    assert err.file == str(path)
+    assert err.field == field
+    assert message in err.message
+    expected_line = _line_of(path, needle)
+    # malformed YAML is reported where the parser notices it: at or just after the bad line
+    assert err.line is not None and expected_line <= err.line <= expected_line + 1
+
+
+@pytest.mark.parametrize("label", ["negative mass", "lower > upper", "unknown parent",
+                                   "inertia not positive definite", "malformed YAML"])
+def test_cli_one_line_no_traceback_no_output(tmp_path, label):
+    case = next(c for c in CASES if c[0] == label)
+    path = _variant(tmp_path, case[1], case[2])
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "build", str(path), "--out", str(out)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode != 0
+    lines = [line for line in proc.stderr.splitlines() if line.strip() and not line.startswith("[")]
+    assert len(lines) == 1, proc.stderr
+    assert "Traceback" not in proc.stderr + proc.stdout
+    assert f"{path}:" in lines[0] and case[4] in lines[0]
+    assert not any(out.glob("*_description")) and not any(out.glob("*.zip"))
+
+
+def test_cli_unknown_robot_and_missing_file(tmp_path):
+    for target in ("no_such_robot", str(tmp_path / "missing.yaml")):
+        proc = subprocess.run([sys.executable, "-m", "simkit.cli", "build", target, "--out",
+                               str(tmp_path)], capture_output=True, text=True, timeout=60)
+        assert proc.returncode != 0
+        assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+        assert "Traceback" not in proc.stderr
+
+
+def test_yaml_line_map_points_at_keys(tmp_path):
+    path = tmp_path / "s.yaml"
+    path.write_text("a: 1\nlist:\n  - x: 2\n    y: 3\n")
+    doc = load_yaml(path)
+    assert doc.lines[("a",)] == 1
+    assert doc.lines[("list", 0, "y")] == 4
+    assert doc.line_of(("list", 0, "missing")) == 3
+
+
+@settings(max_examples=40, deadline=None)
+@given(mass=st.floats(min_value=-1e3, max_value=1e3, allow_nan=False))
+def test_mass_sign_property(tmp_path_factory, mass):
+    path = tmp_path_factory.mktemp("m") / "s.yaml"
+    path.write_text(GOOD.replace("    mass: 7.2\n", f"    mass: {mass!r}\n", 1))
+    if mass > 0:
+        spec, _ = load_spec(path)
+        assert spec.links[1].mass == mass
+    else:
+        with pytest.raises(SpecError, match="mass must be > 0"):
+            load_spec(path)
