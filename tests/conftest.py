@@ -32,3 +32,15 @@ def kit_factory(tmp_path_factory):
 @pytest.fixture(scope="session")
 def rosie_1000(kit_factory) -> BuildResult:
     return kit_factory("rosie_1000")
+
+
+@pytest.fixture(scope="session")
+def rosie_1000_published(tmp_path_factory) -> tuple[Path, dict]:
+    """(site folder, index) of `simkit publish rosie_1000`: a second, independent build of
+    rosie_1000, without the cache, which the reproducibility test compares with `rosie_1000`
+    (so a cache hit and a fresh computation must give the same bytes)."""
+    from simkit.cache import Cache
+    from simkit.publish import publish
+
+    out = tmp_path_factory.mktemp("published") / "sim"
+    return out, publish(out, ["rosie_1000"], cache=Cache.disabled())

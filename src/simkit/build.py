@@ -15,10 +15,11 @@ from pathlib import Path
 
 from simkit import layout
 from simkit.archive import zip_bytes
+from simkit.cache import Cache
 from simkit.check import run_checks
 from simkit.check.findings import Finding
 from simkit.derive import derive_all
-from simkit.emit import emit_all
+from simkit.emit import EMITTERS, emit_all, usd
 from simkit.errors import CheckFailed, UnknownRobot
 from simkit.model import Robot
 from simkit.resolve import resolve
@@ -53,15 +54,17 @@ def find_spec(target: str) -> tuple[Path, str]:
     return path, f"robots/{path.name}"
 
 
-def model_from_spec(target: str, progress: Progress | None = None) -> Robot:
-    """Load, validate, resolve and derive: the frozen model every emitter reads."""
+def model_from_spec(target: str, progress: Progress | None = None, cache: Cache | None = None,
+                    jobs: int | None = None) -> Robot:
+    """Load, validate, resolve and derive: the frozen model every emitter reads. `cache`:
+    see `derive.derive_all` (None: the user cache folder); `jobs`: worker processes."""
     path, shown = find_spec(target)
     say = progress or (lambda _msg: None)
     say(f"spec {shown}")
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
     robot = resolve(spec, doc.text.encode("utf-8"), shown)
     say("derive solids, mass properties, servos")
-    return derive_all(robot, path.parent)
+    return derive_all(robot, path.parent, cache, jobs, progress)
 
 
 def write_tree(root: Path, files: dict[str, bytes]) -> None:
@@ -84,12 +87,15 @@ def _swap_in(staged: Path, final: Path) -> None:
         shutil.rmtree(old) if old.is_dir() else old.unlink()
 
 
-def build(target: str, out_dir: Path, check: bool = True, progress: Progress | None = None) -> BuildResult:
-    """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`."""
+def build(target: str, out_dir: Path, check: bool = True, progress: Progress | None = None,
+          cache: Cache | None = None, jobs: int | None = None,
+          usd_format: str = "usda") -> BuildResult:
+    """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`;
+    `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`."""
     say = progress or (lambda _msg: None)
-    robot = model_from_spec(target, say)
+    robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
-    files = emit_all(robot)
+    files = emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)})
     out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
     staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))

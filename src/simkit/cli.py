@@ -32,9 +32,20 @@ def main() -> None:
               default=Path("build"), show_default=True, help="Folder for kits and zips.")
 @click.option("--no-check", is_flag=True, help="Skip the check stage (not recommended).")
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
-def build(targets: tuple[str, ...], out_dir: Path, no_check: bool, quiet: bool) -> None:
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=None,
+              help="Worker processes for slow per-link steps (CoACD). [default: all cores]")
+@click.option("--cache-dir", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Cache folder. [default: $SIMKIT_CACHE_DIR, else the user cache folder]")
+@click.option("--no-cache", is_flag=True, help="Compute every step; read and write no cache.")
+@click.option("--usd-format", type=click.Choice(["usda", "usdc"]), default="usda",
+              show_default=True, help="USD as text (diffable) or binary crate.")
+def build(targets: tuple[str, ...], out_dir: Path, no_check: bool, quiet: bool,
+          jobs: int | None, cache_dir: Path | None, no_cache: bool, usd_format: str) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
     from simkit.build import build as run_build
+    from simkit.cache import Cache
+
+    cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
 
     for target in targets:
         def progress(msg: str, _t: str = target) -> None:
@@ -42,7 +53,9 @@ def build(targets: tuple[str, ...], out_dir: Path, no_check: bool, quiet: bool) 
                 err.print(f"[{_t}] {msg}", markup=False)
 
         try:
-            result = run_build(target, out_dir, check=not no_check, progress=progress)
+            result = run_build(target, out_dir, check=not no_check,
+                               progress=None if quiet else progress, cache=cache, jobs=jobs,
+                               usd_format=usd_format)
         except SimkitError as exc:
             _fail(exc)
         passed = sum(f.ok for f in result.findings)
@@ -80,6 +93,45 @@ def list_robots() -> None:
 
     for name in robot_names():
         out.print(name, markup=False)
+
+
+@main.command()
+@click.argument("old", type=click.Path(path_type=Path))
+@click.argument("new", type=click.Path(path_type=Path))
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
+def diff(old: Path, new: Path, as_json: bool) -> None:
+    """Report what changed between two kits (folders or zips); exit 0 equal, 1 different."""
+    from simkit.diff import diff_kits, to_markdown
+
+    try:
+        report = diff_kits(old, new)
+    except SimkitError as exc:
+        _fail(exc)
+    click.echo(report.to_json() if as_json else to_markdown(report), nl=False)
+    sys.exit(0 if report.equal else 1)
+
+
+@main.command()
+@click.argument("robots", nargs=-1)
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("build/assets/sim"), show_default=True,
+              help="The site's /assets/sim/ folder (replaced as a whole).")
+@click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
+def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
+    """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and
+    index.json, as the download site serves them under /assets/sim/."""
+    from simkit.publish import publish as run_publish
+
+    def progress(msg: str) -> None:
+        if not quiet:
+            err.print(msg, markup=False)
+
+    try:
+        index = run_publish(out_dir, robots or None, progress=progress)
+    except SimkitError as exc:
+        _fail(exc)
+    files = sum(len(kit["files"]) for kit in index["kits"])
+    out.print(f"published {len(index['kits'])} kit(s), {files} files, to {out_dir}", markup=False)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -7,18 +7,23 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit import dynamics, massprops, solids
+from simkit import collision_pairs, dynamics, inertia_decision, linkwork, massprops, motion
+from simkit.cache import Cache, derived_step
 from simkit.kinematics import forward
 from simkit.model import Robot
 
 
-def derive_solids(robot: Robot, base_dir: Path) -> Robot:
-    """Fill each link's visual solid from its primitives."""
-    links = tuple(
-        replace(link, solid=solids.link_solid(link.shapes, base_dir)) if link.shapes else link
-        for link in robot.links
-    )
-    return replace(robot, links=links)
+def with_json(robot: Robot, key: str, value: object) -> Robot:
+    """Return `robot` with a top-level robot.json entry added by a derive step (robot.json
+    merges `derived["robot_json"]` after its own keys, in insertion order)."""
+    extra = dict(robot.derived.get("robot_json", {}))
+    extra[key] = value
+    return replace(robot, derived={**robot.derived, "robot_json": extra})
+
+
+def derive_solids(robot: Robot, base_dir: Path, cache: Cache | None = None) -> Robot:
+    """Fill each link's visual solid from its primitives (through `cache`, if given)."""
+    return linkwork.derive_solids(robot, base_dir, cache or Cache.disabled())
 
 
 def derive_mass(robot: Robot) -> Robot:
@@ -63,9 +68,18 @@ def derive_references(robot: Robot) -> Robot:
     return replace(robot, derived=derived)
 
 
-def derive_all(robot: Robot, base_dir: Path) -> Robot:
-    """All derive steps in order."""
-    robot = derive_solids(robot, base_dir)
+def derive_all(robot: Robot, base_dir: Path, cache: Cache | None = None, jobs: int | None = None,
+               progress: linkwork.Progress | None = None) -> Robot:
+    """All derive steps in order. `cache` defaults to the user cache folder (`cache.py`);
+    `jobs` is the process count for slow per-link steps (default: the cores)."""
+    cache = Cache.at() if cache is None else cache
+    robot = derive_solids(robot, base_dir, cache)
+    robot = linkwork.derive_collision(robot, cache, jobs, progress)
     robot = derive_mass(robot)
+    robot = inertia_decision.derive_inertia_decisions(robot)
     robot = dynamics.derive_actuators(robot)
-    return derive_references(robot)
+    robot = derive_references(robot)
+    # last: samples the final collision geometry
+    robot = derived_step(robot, cache, "collision_pairs", collision_pairs.derive_collision_pairs)
+    # motion data after the servos: its inverse-dynamics check reads the final MJCF
+    return derived_step(robot, cache, "motion", motion.derive_motion)

@@ -87,15 +87,16 @@ def reference_pose(robot: Robot) -> tuple[float, ...]:
 
 def derive_actuators(robot: Robot) -> Robot:
     """Position servos for actuated joints: kp = effort_peak / 0.01 rad, kv for critical
-    damping of (armature + axis inertia at the reference pose), force limit = drive peak."""
+    damping of (armature + axis inertia at the reference pose), force limit = drive peak;
+    a spec's own kp/kv win."""
     q = reference_pose(robot)
     actuators = []
     for joint in robot.movable_joints:
         if not joint.actuated or joint.effort_peak is None:
             continue
-        kp = joint.effort_peak / SERVO_ERROR_RAD
+        kp = joint.kp if joint.kp is not None else joint.effort_peak / SERVO_ERROR_RAD
         inertia = joint.armature + axis_inertia(robot, joint.name, q)
-        kv = 2.0 * float(np.sqrt(kp * inertia))
+        kv = joint.kv if joint.kv is not None else 2.0 * float(np.sqrt(kp * inertia))
         force = joint.drive_peak_torque_at_joint or joint.effort_peak
         actuators.append(Actuator(joint.name, kp, kv, force))
     return replace(robot, actuators=tuple(actuators))

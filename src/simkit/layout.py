@@ -60,6 +60,27 @@ def benchmark(robot: str, ext: str) -> str:
     return f"benchmark/{robot}_cycle_1kg.{ext}"
 
 
+PACKAGE_XML = "package.xml"
+CMAKELISTS = "CMakeLists.txt"
+DISPLAY_LAUNCH = "launch/display.launch.py"
+INDEX_JSON = "index.json"
+
+
+def rviz(robot: str) -> str:
+    return f"rviz/{robot}.rviz"
+
+
+def example(name: str) -> str:
+    """`mujoco_demo.py` -> `examples/mujoco_demo.py`."""
+    return f"examples/{name}"
+
+
+def asset_dir(robot: str, declared: str | None = None) -> str:
+    """Folder of a kit's files under the download site's /assets/sim/ (the kit page's
+    `<model>`, e.g. `1000`), the spec's `asset_dir` or else the robot name."""
+    return declared or robot
+
+
 def relative(from_file: str, to_file: str) -> str:
     """Path of `to_file` as seen from the folder of `from_file` (e.g. `../meshes/...`)."""
     return posixpath.relpath(to_file, posixpath.dirname(from_file) or ".")

@@ -7,8 +7,13 @@ Transforms follow `T_a_b` = pose of frame b in frame a.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from simkit.spec_mjcf import MjcfSpec
+    from simkit.spec_sim import FreefallSpec, Ros2ControlSpec
 
 Vec3 = tuple[float, float, float]
 Rgba = tuple[float, float, float, float]
@@ -64,6 +69,19 @@ class Mesh:
 
 
 @dataclass(frozen=True)
+class InertiaDecision:
+    """A recorded decision to keep a non-physical reported inertia (spec_sim.py): the reported
+    tensor and the problem with it, and the balanced tensor the URDF and MJCF carry instead
+    (filled by the derive step; (ixx, iyy, izz, ixy, ixz, iyz), kg m^2)."""
+
+    action: str
+    reason: str
+    reported: tuple[float, float, float, float, float, float]
+    problem: str
+    emitted: tuple[float, float, float, float, float, float] | None = None
+
+
+@dataclass(frozen=True)
 class Link:
     """A rigid body. `solid` is the visual solid (None until derived); `collision` holds the
     convex pieces or primitives (empty until derived)."""
@@ -80,6 +98,7 @@ class Link:
     solid: Mesh | None = None
     collision: tuple[Mesh, ...] = ()
     collision_report: dict | None = None
+    inertia_decision: InertiaDecision | None = None
 
 
 @dataclass(frozen=True)
@@ -121,10 +140,18 @@ class Joint:
     actuated: bool = True
     drive: Drive | None = None
     estimated: tuple[str, ...] = ()
+    solreflimit: tuple[float, float] | None = None
+    solimplimit: tuple[float, float, float] | None = None
+    margin: float = 0.0
+    kp: float | None = None
+    kv: float | None = None
+    mjcf_class: str | None = None
 
     @property
     def movable(self) -> bool:
-        return self.type != "fixed"
+        """A one-degree-of-freedom joint (a floating base is neither fixed nor 1-DOF: it has
+        no entry in poses, robot.json `joints` or the servos)."""
+        return self.type not in ("fixed", "floating")
 
 
 @dataclass(frozen=True)
@@ -136,6 +163,7 @@ class Frame:
     xyz: Vec3
     rpy: Vec3
     estimated: tuple[str, ...] = ()
+    site_size: float | None = None
 
 
 @dataclass(frozen=True)
@@ -146,6 +174,15 @@ class Actuator:
     kp: float
     kv: float
     forcerange: float
+
+
+@dataclass(frozen=True)
+class PlanningGroup:
+    """A MoveIt planning group: the chain from link `base` to link or frame `tip`."""
+
+    name: str
+    base: str
+    tip: str
 
 
 @dataclass(frozen=True)
@@ -172,6 +209,13 @@ class Robot:
     spec_file: str
     actuators: tuple[Actuator, ...] = ()
     derived: dict = field(default_factory=dict)
+    planning_groups: tuple[PlanningGroup, ...] = ()
+    #: MuJoCo scene settings (`spec_mjcf.MjcfSpec`, frozen), or None for simkit's defaults.
+    mjcf: MjcfSpec | None = None
+    asset_dir: str | None = None
+    #: Gazebo / ros2_control additions and the free-fall validation (frozen spec sections)
+    ros2_control: Ros2ControlSpec | None = None
+    freefall: FreefallSpec | None = None
 
     def link(self, name: str) -> Link:
         for link in self.links:
@@ -184,6 +228,11 @@ class Robot:
             if joint.name == name:
                 return joint
         raise KeyError(name)
+
+    @property
+    def floating_joint(self) -> Joint | None:
+        """The free joint between the root and the floating base link, if any."""
+        return next((j for j in self.joints if j.type == "floating"), None)
 
     @property
     def movable_joints(self) -> tuple[Joint, ...]:

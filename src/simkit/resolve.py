@@ -7,8 +7,9 @@ import math
 
 import numpy as np
 
+from simkit.inertia_decision import decision_of
 from simkit.kinematics import matrix_rpy, tree_order
-from simkit.model import Drive, Frame, Inertial, Joint, Link, Robot, Shape
+from simkit.model import Drive, Frame, Inertial, Joint, Link, PlanningGroup, Robot, Shape
 from simkit.spec import CollisionPrimitive, DriveSpec, JointSpec, Primitive, RobotSpec
 
 
@@ -110,9 +111,15 @@ def joint_of(spec: JointSpec) -> Joint:
         friction=spec.friction,
         stiffness=spec.stiffness,
         springref=spec.springref,
-        actuated=spec.actuated and spec.type != "fixed",
+        actuated=spec.actuated and spec.type not in ("fixed", "floating"),
         drive=drive,
         estimated=tuple(spec.estimated),
+        solreflimit=spec.solreflimit,
+        solimplimit=spec.solimplimit,
+        margin=spec.margin,
+        kp=spec.kp,
+        kv=spec.kv,
+        mjcf_class=spec.mjcf_class,
     )
 
 
@@ -137,6 +144,7 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
                 collision_primitives=tuple(shape_of(p) for p in link.collision_primitives),
                 estimated=tuple(link.estimated),
                 note=link.note,
+                inertia_decision=decision_of(link),
             )
         )
     poses = {name: tuple(float(v) for v in values) for name, values in spec.poses.items()}
@@ -149,11 +157,12 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         title=spec.title,
         description=spec.description,
         root=spec.root,
-        floating_base=spec.floating_base,
+        floating_base=spec.floating_base or any(j.type == "floating" for j in spec.joints),
         links=tuple(links),
         joints=joints,
         frames=tuple(
-            Frame(f.name, f.parent, tuple(float(v) for v in f.xyz), f.rpy_rad(), tuple(f.estimated))  # type: ignore[arg-type]
+            Frame(f.name, f.parent, tuple(float(v) for v in f.xyz), f.rpy_rad(), tuple(f.estimated),  # type: ignore[arg-type]
+                  f.site_size)
             for f in spec.frames
         ),
         materials=tuple((m.name, m.rgba) for m in spec.materials),
@@ -166,4 +175,9 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         seed=spec.seed,
         spec_sha256=hashlib.sha256(spec_bytes).hexdigest(),
         spec_file=spec_file,
+        planning_groups=tuple(PlanningGroup(g.name, g.base, g.tip) for g in spec.planning_groups),
+        asset_dir=spec.asset_dir,
+        mjcf=spec.mjcf,
+        ros2_control=spec.ros2_control,
+        freefall=spec.freefall,
     )

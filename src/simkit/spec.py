@@ -12,6 +12,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from simkit.spec_mjcf import MjcfSpec
+from simkit.spec_sim import FreefallSpec, InertiaDecisionSpec, Ros2ControlSpec
+
 Vec3 = tuple[float, float, float]
 Rgba = tuple[float, float, float, float]
 PositiveFloat = Annotated[float, Field(gt=0)]
@@ -125,6 +128,8 @@ class LinkSpec(Strict):
     collision_primitives: tuple[CollisionPrimitive, ...] = ()
     estimated: tuple[str, ...] = ()
     note: str | None = None
+    #: keep a non-physical reported inertia on purpose (spec_sim.InertiaDecisionSpec)
+    inertia_decision: InertiaDecisionSpec | None = None
 
     @field_validator("mass")
     @classmethod
@@ -152,7 +157,7 @@ class JointSpec(Placed):
     """A joint between two links. `xyz`/`rpy` place the child frame in the parent frame."""
 
     name: str
-    type: Literal["revolute", "continuous", "prismatic", "fixed"] = "revolute"
+    type: Literal["revolute", "continuous", "prismatic", "fixed", "floating"] = "revolute"
     parent: str
     child: str
     axis: Vec3 = (0.0, 0.0, 1.0)
@@ -172,6 +177,14 @@ class JointSpec(Placed):
     stiffness: NonNegFloat = 0.0
     springref: float = 0.0
     actuated: bool = True
+    # Joint-limit contact (MuJoCo solreflimit, solimplimit, margin in rad or m), servo gains
+    # (N m/rad, N m s/rad; derived from effort_peak when absent) and the MJCF default class.
+    solreflimit: tuple[float, float] | None = None
+    solimplimit: tuple[float, float, float] | None = None
+    margin: NonNegFloat = 0.0
+    kp: PositiveFloat | None = None
+    kv: NonNegFloat | None = None
+    mjcf_class: str | None = None
     estimated: tuple[str, ...] = ()
 
     @model_validator(mode="after")
@@ -190,6 +203,7 @@ class FrameSpec(Placed):
 
     name: str
     parent: str
+    site_size: PositiveFloat | None = None  # m, radius of the MJCF site (default 0.005)
     estimated: tuple[str, ...] = ()
 
 
@@ -209,7 +223,18 @@ class PublishedSpec(Strict):
     reach_flange: PositiveFloat | None = None
     payload: PositiveFloat | None = None
     repeatability_mm: PositiveFloat | None = None
+    #: m above base_link of the benchmark cycle's low points (kit page, "Benchmark cycle")
+    benchmark_low_height: float | None = None
     estimated: tuple[str, ...] = ()
+
+
+class PlanningGroupSpec(Strict):
+    """A MoveIt planning group: the kinematic chain from link `base` to link or frame `tip`
+    (SRDF `<chain>`). Without any, the SRDF has `manipulator`: base_link -> tool frame."""
+
+    name: str
+    base: str
+    tip: str
 
 
 class RobotSpec(Strict):
@@ -231,3 +256,11 @@ class RobotSpec(Strict):
     poses: dict[str, tuple[float, ...]] = Field(default_factory=dict)
     published: PublishedSpec = PublishedSpec()
     seed: int = 0
+    mjcf: MjcfSpec | None = None
+    planning_groups: tuple[PlanningGroupSpec, ...] = ()
+    #: Folder name under the download site's /assets/sim/ (the page's `<model>`, e.g. "1000");
+    #: defaults to `name`.
+    asset_dir: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")] | None = None
+    #: Gazebo / ros2_control additions and the free-fall validation (spec_sim.py)
+    ros2_control: Ros2ControlSpec | None = None
+    freefall: FreefallSpec | None = None

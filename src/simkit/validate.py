@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
+from simkit import spec_mjcf, spec_sim
 from simkit.errors import SpecError
 from simkit.spec import InertiaSpec, RobotSpec
 from simkit.yamlsource import Loc, SourceDoc, dotted, load_yaml
@@ -67,8 +68,8 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield ("links", i, "material"), f"unknown material '{link.material}'"
         if link.inertia is not None:
             why = inertia_problem(link.inertia)
-            if why:
-                yield ("links", i, "inertia"), why
+            if why and link.inertia_decision is None:
+                yield ("links", i, "inertia"), why + " (fix it, or record an inertia_decision)"
         if link.inertia is not None and link.com is None:
             yield ("links", i, "com"), "a link that gives its inertia must give its com too"
         if not link.solid and link.collision != "primitives":
@@ -105,8 +106,11 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
         if frame.parent != spec.root and frame.parent not in links:
             yield ("frames", i, "parent"), f"unknown parent link '{frame.parent}'"
     yield from _cycles(spec)
+    yield from _floating(spec)
+    yield from spec_mjcf.problems(spec, set(links), {f.name for f in spec.frames})
+    yield from spec_sim.problems(spec, inertia_problem)
 
-    movable = [j for j in spec.joints if j.type != "fixed"]
+    movable = [j for j in spec.joints if j.type not in ("fixed", "floating")]
     for key in ("poses", "poses_deg"):
         for pose, values in getattr(spec, key).items():
             if len(values) != len(movable):
@@ -117,9 +121,55 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
         value = getattr(spec, key)
         if value is not None and value not in names_seen:
             yield (key,), f"unknown link or frame '{value}'"
+    yield from _planning_groups(spec)
     for k, field in enumerate(spec.published.estimated):
         if field not in ESTIMABLE_ROBOT:
             yield ("published", "estimated", k), f"'{field}' is not a published figure"
+
+
+def _planning_groups(spec: RobotSpec) -> Iterator[Problem]:
+    """Each planning group's tip must be a link or frame below its base link (SRDF chain)."""
+    parent = {j.child: j.parent for j in spec.joints}
+    parent.update({f.name: f.parent for f in spec.frames})
+    names: set[str] = set()
+    for i, group in enumerate(spec.planning_groups):
+        if group.name in names:
+            yield ("planning_groups", i, "name"), f"group name '{group.name}' is already used"
+        names.add(group.name)
+        if group.base != spec.root and group.base not in {link.name for link in spec.links}:
+            yield ("planning_groups", i, "base"), f"unknown link '{group.base}'"
+            continue
+        node, seen = group.tip, set()
+        while node != group.base and node in parent and node not in seen:
+            seen.add(node)
+            node = parent[node]
+        if node != group.base:
+            why = f"'{group.tip}' is not a link or frame below '{group.base}'"
+            yield ("planning_groups", i, "tip"), why
+
+
+def _floating(spec: RobotSpec) -> Iterator[Problem]:
+    """A floating base is one `floating` joint from the root (the world) to the base link; the
+    URDF starts at that link, so nothing else may hang on the root."""
+    floating = [i for i, j in enumerate(spec.joints) if j.type == "floating"]
+    for i in floating[1:]:
+        yield ("joints", i, "type"), "only one joint may be floating"
+    for i in floating:
+        joint = spec.joints[i]
+        if joint.parent != spec.root:
+            yield ("joints", i, "parent"), f"a floating joint must hang on the root '{spec.root}'"
+        for key in ("lower", "upper", "lower_deg", "upper_deg"):
+            if getattr(joint, key) is not None:
+                yield ("joints", i, key), "a floating joint has no limits"
+    if spec.floating_base and not floating:
+        yield ("floating_base",), "floating_base needs a joint of type 'floating' from the root"
+    if floating:
+        for i, joint in enumerate(spec.joints):
+            if joint.parent == spec.root and joint.type != "floating":
+                yield ("joints", i, "parent"), "with a floating base only it may hang on the root"
+        for i, frame in enumerate(spec.frames):
+            if frame.parent == spec.root:
+                yield ("frames", i, "parent"), "with a floating base frames go on links"
 
 
 def _cycles(spec: RobotSpec) -> Iterator[Problem]:

@@ -30,7 +30,7 @@ class Finding:
 
 
 def _g(value) -> str:
-    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    arr = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
     text = ", ".join(f"{v:.6g}" for v in arr)
     return text if arr.size == 1 else f"({text})"
 

@@ -19,6 +19,12 @@ def load_mjcf(kit: Kit) -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_path(str(kit.path(kit.mjcf)))
 
 
+def load_control_mjcf(kit: Kit) -> mujoco.MjModel:
+    """The MJCF with the position servos: the scene file where the main file has none
+    (robot.json `files.mjcf_scene`), else the main file."""
+    return mujoco.MjModel.from_xml_path(str(kit.path(kit.doc["files"].get("mjcf_scene", kit.mjcf))))
+
+
 def load_urdf_in_mujoco(kit: Kit) -> mujoco.MjModel:
     """Compile the URDF in MuJoCo, keeping fixed frames as bodies and the relative mesh paths
     (MuJoCo's URDF reader strips directories unless told not to)."""
@@ -130,7 +136,7 @@ def check_hold(kit: Kit) -> list[Finding]:
     """Position servos hold each named pose under gravity within a few tenths of a degree,
     with no contact between the robot's own links on the way."""
     mj = load_mjcf(kit)
-    if mj.nu == 0:
+    if mj.nu == 0 or "floating_base" in kit.doc:  # a floating base: check/legged_check.py
         return []
     names = [j["name"] for j in kit.joints]
     acts = [mj.actuator(i).name for i in range(mj.nu)]

@@ -8,6 +8,11 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from simkit.emit import docs, meshes, mjcf, robot_json, urdf
+from simkit.emit import examples, ros2, srdf
+from simkit.emit import usd
+from simkit.emit import motion_files
+from simkit.emit import glb
+from simkit.emit import mjcf_scene
 from simkit.model import Robot
 
 Emitter = Callable[[Robot], dict[str, bytes]]
@@ -16,8 +21,15 @@ EMITTERS: dict[str, Emitter] = {
     "meshes": meshes.emit,
     "urdf": urdf.emit,
     "mjcf": mjcf.emit,
+    "mjcf_scene": mjcf_scene.emit,
     "robot_json": robot_json.emit,
     "docs": docs.emit,
+    "srdf": srdf.emit,
+    "ros2": ros2.emit,
+    "examples": examples.emit,
+    "usd": usd.emit,
+    "motion_files": motion_files.emit,
+    "glb": glb.emit,
 }
 
 

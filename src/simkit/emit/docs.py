@@ -8,7 +8,9 @@ from functools import cache
 import jinja2
 
 from simkit import layout
+from simkit.emit import mjcf_world
 from simkit.fmt import num
+from simkit.kinematics import quat_wxyz, rpy_matrix
 from simkit.model import Robot
 from simkit.resources import data_dir
 
@@ -63,9 +65,30 @@ def context(robot: Robot) -> dict:
         "root": robot.root,
         "tool": robot.tool_frame or "",
         "n_movable": len(robot.movable_joints),
-        "has_actuators": bool(robot.actuators),
+        "has_actuators": bool(robot.actuators) and mjcf_world.servos_in_main(robot),
         "demo_q": demo,
         "sources": list(robot.sources),
+        **_floating(robot),
+    }
+
+
+def _floating(robot: Robot) -> dict:
+    """Values for the floating-base quickstart (the loading snippets of the robot's MuJoCo
+    reference): free-joint start, an example joint, sensor names, the file with the servos."""
+    joint = robot.floating_joint
+    scene = "" if mjcf_world.servos_in_main(robot) else layout.mjcf_scene(robot.name)
+    movable = robot.movable_joints
+    return {
+        "floating": None if joint is None else {
+            "joint": joint.name, "child": joint.child, "xyz": ", ".join(num(v) for v in joint.xyz),
+            "quat": ", ".join(num(v) for v in quat_wxyz(rpy_matrix(joint.rpy))),
+        },
+        "fixed_base": "False" if joint is not None else "True",
+        "scene": scene,
+        "control_mjcf": scene or layout.mjcf(robot.name),
+        "home_key": bool(scene) and "home" in dict(robot.poses),
+        "example_joint": movable[0].name if movable else "",
+        "sensors": [f'"{s.name}"' for s in (robot.mjcf.sensors if robot.mjcf else ())],
     }
 
 

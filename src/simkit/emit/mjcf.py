@@ -11,6 +11,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from simkit import layout
+from simkit.emit import mjcf_world
 from simkit.fmt import num, vec
 from simkit.kinematics import quat_wxyz, rpy_matrix
 from simkit.model import Link, Robot, Shape
@@ -54,13 +55,14 @@ def _assets(robot: Robot, mujoco: ET.Element) -> None:
         for i in range(len(link.collision)):
             sub(asset, "mesh", name=_mesh_name(link.name, i),
                 file=layout.collision_mesh(link.name, i).removeprefix(meshdir))
+    mjcf_world.assets(robot, asset)
 
 
 def _geoms(body: ET.Element, link: Link) -> None:
     if link.solid is not None:
         sub(body, "geom", {"name": f"{link.name}_visual", "class": "visual",
                            "mesh": _mesh_name(link.name), "material": link.material})
-    if link.collision_primitives:
+    if link.collision_primitives or link.collision_method == "primitives":
         for i, shape in enumerate(link.collision_primitives):
             _primitive(body, shape, f"{link.name}_collision_{i:02d}")
     elif link.collision:
@@ -93,12 +95,14 @@ def _body(robot: Robot, parent: ET.Element, link_name: str) -> None:
         if joint.stiffness:
             attrs["stiffness"] = num(joint.stiffness)
             attrs["springref"] = num(joint.springref)
+        mjcf_world.joint_extras(joint, attrs)
         sub(body, "joint", attrs)
     _geoms(body, link)
     for frame in robot.frames:
         if frame.parent == link.name:
             sub(body, "site", name=frame.name, pos=vec(frame.xyz), quat=_quat(frame.rpy),
-                size="0.005")
+                size=num(frame.site_size) if frame.site_size else "0.005")
+    mjcf_world.cameras(robot, body, link.name)
     for child in robot.joints:
         if child.parent == link.name:
             _body(robot, body, child.child)
@@ -116,14 +120,19 @@ def emit(robot: Robot) -> dict[str, bytes]:
     mujoco = ET.Element("mujoco", model=robot.name)
     sub(mujoco, "compiler", angle="radian", meshdir=layout.relative(file, "meshes"),
         autolimits="true")
-    sub(mujoco, "option", timestep=num(TIMESTEP), integrator="implicitfast")
+    sub(mujoco, "option", timestep=num(mjcf_world.timestep(robot, TIMESTEP)),
+        integrator="implicitfast")
+    mjcf_world.visual(robot, mujoco)
     default = sub(sub(mujoco, "default"), "default", {"class": robot.name})
-    sub(sub(default, "default", {"class": "visual"}), "geom",
-        type="mesh", contype="0", conaffinity="0", group="2")
-    sub(sub(default, "default", {"class": "collision"}), "geom", type="mesh", group="3")
+    visual = sub(default, "default", {"class": "visual"})
+    sub(visual, "geom", type="mesh", contype="0", conaffinity="0", group="2")
+    collision = sub(default, "default", {"class": "collision"})
+    sub(collision, "geom", type="mesh", group="3")
+    mjcf_world.defaults(robot, default, {"visual": visual, "collision": collision})
     _assets(robot, mujoco)
     world = sub(mujoco, "worldbody")
-    sub(world, "light", name="top", pos="0 0 3", dir="0 0 -1", directional="true")
+    if not mjcf_world.world(robot, world):
+        sub(world, "light", name="top", pos="0 0 3", dir="0 0 -1", directional="true")
     for frame in robot.frames:
         if frame.parent == robot.root:
             sub(world, "site", name=frame.name, pos=vec(frame.xyz), quat=_quat(frame.rpy))
@@ -137,6 +146,14 @@ def emit(robot: Robot) -> dict[str, bytes]:
     contact = sub(mujoco, "contact")
     for a, b in adjacent_pairs(robot):
         sub(contact, "exclude", body1=a, body2=b)
+    mjcf_world.sensors(robot, mujoco)
+    if mjcf_world.servos_in_main(robot):
+        actuators(robot, mujoco)
+    return {file: to_bytes(mujoco, HEADER.format(spec=robot.spec_file))}
+
+
+def actuators(robot: Robot, mujoco: ET.Element) -> None:
+    """`<actuator>`: one position servo per actuated joint (robot.actuators)."""
     if robot.actuators:
         actuator = sub(mujoco, "actuator")
         for act in robot.actuators:
@@ -146,4 +163,3 @@ def emit(robot: Robot) -> dict[str, bytes]:
                 attrs["ctrlrange"] = vec((joint.lower, joint.upper))
             attrs["forcerange"] = vec((-act.forcerange, act.forcerange))
             sub(actuator, "position", attrs)
-    return {file: to_bytes(mujoco, HEADER.format(spec=robot.spec_file))}

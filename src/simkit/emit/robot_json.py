@@ -5,7 +5,8 @@ from __future__ import annotations
 import math
 from importlib import metadata
 
-from simkit import __version__, layout
+from simkit import __version__, inertia_decision, layout
+from simkit.emit import mjcf_world
 from simkit.jsonout import dumps
 from simkit.model import Joint, Link, Robot
 from simkit.solids import CIRCULAR_SEGMENTS
@@ -17,7 +18,7 @@ def _deg(value: float | None) -> float | None:
     return None if value is None else math.degrees(value)
 
 
-def _joint(joint: Joint) -> dict:
+def _joint(joint: Joint, extra: dict | None = None) -> dict:
     out: dict = {
         "name": joint.name,
         "type": joint.type,
@@ -38,6 +39,8 @@ def _joint(joint: Joint) -> dict:
         "armature": joint.armature,
         "damping": joint.damping,
         "friction": joint.friction,
+        # derive-step additions, e.g. derived_max_acceleration (motion.py)
+        **(extra or {}),
     }
     if joint.stiffness:
         out.update(stiffness=joint.stiffness, springref=joint.springref)
@@ -77,6 +80,8 @@ def _link(link: Link) -> dict:
     }
     if link.note:
         out["note"] = link.note
+    if link.inertia_decision is not None:  # kept non-physical inertia: recorded, never silent
+        out["inertia_decision"] = inertia_decision.record(link.inertia_decision)
     return out
 
 
@@ -115,15 +120,17 @@ def document(robot: Robot) -> dict:
         "title": robot.title,
         "description": robot.description,
         "units": {"length": "m", "mass": "kg", "angle": "rad", "time": "s", "torque": "N m"},
-        "files": {"urdf": layout.urdf(robot.name), "mjcf": layout.mjcf(robot.name)},
+        "files": {"urdf": layout.urdf(robot.name), "mjcf": layout.mjcf(robot.name),
+                  "glb": layout.glb(robot.name)},
         "base_frame": robot.derived.get("base_frame", robot.root),
         "tool_frame": robot.tool_frame,
         "wrist_centre": robot.wrist_centre,
-        "joints": [_joint(j) for j in robot.movable_joints],
+        "joints": [_joint(j, robot.derived.get("joint_json", {}).get(j.name))
+                   for j in robot.movable_joints],
         "fixed_joints": [
             {"name": j.name, "parent": j.parent, "child": j.child, "origin_xyz": list(j.xyz),
              "origin_rpy": list(j.rpy)}
-            for j in robot.joints if not j.movable
+            for j in robot.joints if j.type == "fixed"
         ],
         "links": [_link(link) for link in robot.links],
         "frames": _frames(robot),
@@ -147,6 +154,7 @@ def document(robot: Robot) -> dict:
             "plain envelopes",
             "mass_properties": "CoM and inertia of the solid at uniform density scaled to the "
             "link mass, unless the spec gives them",
+            "collision": robot.derived.get("geometry_collision"),
             "links": robot.derived.get("geometry_links", []),
         },
         "actuators": [
@@ -158,13 +166,41 @@ def document(robot: Robot) -> dict:
             "spec_sha256": robot.spec_sha256,
             "simkit_version": __version__,
             "libraries": _versions(),
-            "seeds": {"spec": robot.seed},
+            "seeds": {"spec": robot.seed, **robot.derived.get("seeds", {})},
             "sources": list(robot.sources),
             "published_estimated": list(robot.published_estimated),
         },
     }
-    doc.update(robot.derived.get("robot_json_extra", {}))
+    _generalise(robot, doc)
+    doc.update(robot.derived.get("robot_json", {}))
     return doc
+
+
+def _generalise(robot: Robot, doc: dict) -> None:
+    """Drop the arm-only entries where they do not apply (no wrist centre or tool frame, no
+    payload or repeatability published) and add a floating base, the MJCF scene file and the
+    MJCF sensors where the spec has them. Arm kits are unchanged."""
+    if not (robot.wrist_centre or robot.tool_frame):
+        doc.pop("fk_reference")
+        if not robot.derived.get("reach_geometric") and not doc["reach"]["published"]["wrist"]:
+            doc.pop("reach")
+    if doc["payload"]["rated"] is None:
+        doc.pop("payload")
+    if doc["repeatability_mm"] is None:
+        doc.pop("repeatability_mm")
+    floating = robot.floating_joint
+    if floating is not None:
+        doc["floating_base"] = {
+            "joint": floating.name, "parent": floating.parent, "child": floating.child,
+            "origin_xyz": list(floating.xyz), "origin_rpy": list(floating.rpy),
+            "note": "MJCF free joint; the URDF's root is the child link (no world joint); "
+            "MuJoCo qpos starts with its position (m) and quaternion (w, x, y, z)",
+        }
+        doc["frames"][robot.root]["role"] = "the world; the floating base moves freely in it"
+    if not mjcf_world.servos_in_main(robot):
+        doc["files"]["mjcf_scene"] = layout.mjcf_scene(robot.name)
+    if robot.mjcf is not None and robot.mjcf.sensors:
+        doc["sensors"] = [s.model_dump(exclude_none=True) for s in robot.mjcf.sensors]
 
 
 def emit(robot: Robot) -> dict[str, bytes]:

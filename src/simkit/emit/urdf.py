@@ -34,7 +34,7 @@ def _primitive_geometry(parent: ET.Element, shape: Shape) -> None:
 def collision_elements(robot: Robot, link: Link, file: str) -> list[ET.Element]:
     """<collision> elements of a link: mesh pieces, primitives, or the visual mesh."""
     out: list[ET.Element] = []
-    if link.collision_primitives:
+    if link.collision_primitives or link.collision_method == "primitives":
         for i, shape in enumerate(link.collision_primitives):
             col = ET.Element("collision", name=f"{link.name}_collision_{i:02d}")
             _origin(col, shape.xyz, shape.rpy)
@@ -104,10 +104,12 @@ def emit(robot: Robot) -> dict[str, bytes]:
     for name, rgba in robot.materials:
         material = sub(root, "material", name=name)
         sub(material, "color", rgba=vec(rgba))
-    sub(root, "link", name=robot.root)
+    if robot.floating_joint is None:  # URDF has no floating joint: the base link is the root
+        sub(root, "link", name=robot.root)
     links = {link.name: link for link in robot.links}
     for joint in robot.joints:
-        _joint(root, joint)
+        if joint.type != "floating":
+            _joint(root, joint)
         _link(robot, root, links[joint.child], file)
     for frame in robot.frames:
         joint = sub(root, "joint", name=f"{frame.name}_joint", type="fixed")

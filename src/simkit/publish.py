@@ -1,0 +1,113 @@
+"""`simkit publish`: build every robot and lay the kits out as the download site serves them.
+
+Kit page, "Downloads": every file of every kit has its own URL under /assets/sim/<model>/,
+with the same layout as the zip, and /assets/sim/index.json lists the kits and all their
+files. So the output folder (the site's /assets/sim/) holds:
+
+    index.json                       kits, and every file with its size and sha256
+    rosie-1000-sim-kit.zip           the kit zip (unzips to rosie_1000_description/)
+    1000/robot.json, 1000/urdf/...   the kit's files, one URL each (<model> = spec asset_dir)
+
+The whole folder is built beside the output and swapped in at the end, so a failed build
+leaves the previous publication in place.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import tempfile
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from simkit import layout
+from simkit.build import _swap_in, build, find_spec, write_tree
+from simkit.errors import SimkitError
+from simkit.jsonout import dumps
+from simkit.resources import robot_names
+from simkit.validate import load_spec
+
+INDEX_FORMAT = 1
+
+
+def _entry(path: str, data: bytes, url: str | None = None) -> dict:
+    out = {"path": path, "size": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+    if url is not None:
+        out["url"] = url
+    return out
+
+
+def _asset_dir(target: str, name: str) -> str:
+    spec, _ = load_spec(find_spec(target)[0])
+    return layout.asset_dir(name, spec.asset_dir)
+
+
+def _check_out_dir(out_dir: Path) -> None:
+    """Refuse to replace a folder that is not an earlier publication."""
+    if out_dir.is_file():
+        raise SimkitError(f"{out_dir}: is a file, not a folder")
+    if out_dir.is_dir() and any(out_dir.iterdir()) and not (out_dir / layout.INDEX_JSON).is_file():
+        raise SimkitError(
+            f"{out_dir}: not empty and not an earlier publication (no "
+            f"{layout.INDEX_JSON}); choose another --out"
+        )
+
+
+def publish(
+    out_dir: Path,
+    targets: Sequence[str] | None = None,
+    progress: Callable[[str], None] | None = None,
+    **build_options,
+) -> dict:
+    """Build `targets` (default: every robot in robots/), check them, and write the site
+    folder; returns the index. `build_options` go to `build.build` (cache, jobs)."""
+    say = progress or (lambda _msg: None)
+    out_dir = Path(out_dir)
+    _check_out_dir(out_dir)
+    names = list(targets) if targets else robot_names()
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(
+        tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".staging", dir=out_dir.parent)
+    )
+    try:
+        site, work = staging / "site", staging / "kits"
+        site.mkdir()
+        kits = []
+        for target in names:
+            say(f"build {target}")
+            result = build(target, work, check=True, progress=progress, **build_options)
+            top = layout.kit_dir_name(result.robot)
+            folder = _asset_dir(target, result.robot)
+            if any(kit["folder"] == f"{folder}/" for kit in kits):
+                raise SimkitError(
+                    f"{target}: asset folder '{folder}' is already used by "
+                    "another kit (set a distinct asset_dir in the spec)"
+                )
+            zip_data = result.zip_path.read_bytes()
+            (site / result.zip_path.name).write_bytes(zip_data)
+            write_tree(site / folder, result.files)
+            doc = json.loads(result.files[layout.ROBOT_JSON])
+            kits.append(
+                {
+                    "name": result.robot,
+                    "title": doc.get("title", result.robot),
+                    "folder": f"{folder}/",
+                    "top_folder": f"{top}/",
+                    "zip": _entry(result.zip_path.name, zip_data),
+                    "files": [
+                        _entry(f"{top}/{path}", data, f"{folder}/{path}")
+                        for path, data in sorted(result.files.items())
+                    ],
+                }
+            )
+        index = {
+            "format": INDEX_FORMAT,
+            "note": "paths are as in each zip; urls are relative to this file's folder",
+            "kits": kits,
+        }
+        (site / layout.INDEX_JSON).write_bytes(dumps(index))
+        _swap_in(site, out_dir)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return index

@@ -1,0 +1,158 @@
+"""Collision pieces (issue 3): exact convex pieces, greedy merging, CoACD through the cache,
+spec primitives, quality figures, and what the URDF and MJCF make of them."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import manifold3d as mf
+import numpy as np
+import pytest
+
+from simkit import collision, linkwork
+from simkit.build import model_from_spec
+from simkit.cache import Cache
+from simkit.check.geometry_check import _outside
+from simkit.errors import SpecError
+from simkit.model import Mesh
+from simkit.resources import robot_names
+from simkit.solids import to_mesh
+from simkit.stl import from_stl
+
+MIX = str(Path(__file__).resolve().parent / "specs" / "collision_mix.yaml")
+ROSIES = [name for name in robot_names() if name.startswith("rosie_")]
+
+
+def _trimesh(mesh: Mesh):
+    import trimesh
+
+    return trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)
+
+
+def test_merge_greedy_takes_the_pair_that_adds_least_volume():
+    a = mf.Manifold.cube((1, 1, 1))
+    b = mf.Manifold.cube((1, 1, 1)).translate((1, 0, 0))  # touches a: merging adds nothing
+    c = mf.Manifold.cube((1, 1, 1)).translate((0, 3, 0))
+    merged = collision.merge_greedy([c, a, b], limit=2)
+    assert sorted(round(m.volume(), 9) for m in merged) == [1.0, 2.0]
+
+
+def test_distance_to_surface_matches_a_box():
+    box = to_mesh(mf.Manifold.cube((2, 2, 2), center=True))
+    rng = np.random.default_rng(0)
+    points = rng.uniform(-3, 3, size=(400, 3))
+    inside = np.abs(points).max(axis=1) <= 1
+    exact = np.where(inside, 1 - np.abs(points).max(axis=1),
+                     np.linalg.norm(np.maximum(np.abs(points) - 1, 0), axis=1))
+    for k in range(0, 400, 40):
+        got = collision.max_distance_to_surface(points[k:k + 40], box, block=16)
+        assert got == pytest.approx(exact[k:k + 40].max(), abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ROSIES)
+def test_rosie_links_have_at_most_ten_convex_pieces_covering_the_visual(name):
+    robot = model_from_spec(name)
+    for link in robot.links:
+        assert 1 <= len(link.collision) <= 10, link.name
+        assert all(_trimesh(p).is_convex for p in link.collision), link.name
+        depth = np.min([_outside(link.solid.vertices, p.vertices, p.faces)
+                        for p in link.collision], axis=0)
+        assert depth.max() < 1e-9, link.name
+        report = link.collision_report
+        assert report["method"] == "convex" and report["pieces"] == len(link.collision)
+        assert report["hull_volume_ratio"] <= 1.05
+        assert report["coverage"] >= 0.9999
+        assert report["visual_to_collision_max_m"] <= 0.002
+
+
+def test_rosie_1000_kit_writes_the_pieces_and_their_quality(rosie_1000):
+    kit = rosie_1000.kit_dir
+    doc = json.loads((kit / "robot.json").read_text())
+    reports = {g["name"]: g["collision"] for g in doc["geometry"]["links"]}
+    assert doc["geometry"]["collision"]["coacd_parameters"]["threshold"] == 0.1
+    for link in doc["links"]:
+        paths = link["mesh"]["collision"]
+        assert paths and reports[link["name"]]["pieces"] == len(paths)
+        pieces = [from_stl((kit / p).read_bytes()) for p in paths]
+        assert all(_trimesh(p).is_convex for p in pieces), link["name"]
+        visual = from_stl((kit / link["mesh"]["visual"]).read_bytes()).vertices
+        depth = np.min([_outside(visual, p.vertices, p.faces) for p in pieces], axis=0)
+        assert depth.max() < 1e-6, link["name"]
+
+
+def test_convex_needs_a_convex_union():
+    from simkit.resolve import resolve
+    from simkit.validate import load_spec
+
+    spec, doc = load_spec(Path(MIX), display=MIX)
+    hub = resolve(spec, doc.text.encode(), MIX).link("hub")
+    assert collision.method_of(hub) == "coacd"
+    with pytest.raises(SpecError, match="convex"):
+        collision.method_of(replace(hub, collision_method="convex"))
+
+
+def _pieces(robot) -> dict[str, list[bytes]]:
+    return {link.name: [p.vertices.tobytes() + p.faces.tobytes() for p in link.collision]
+            for link in robot.links}
+
+
+def test_coacd_cached_warm_runs_none_and_corrupt_entries_are_repaired(tmp_path):
+    cache = Cache.at(tmp_path / "cache")
+    start = collision.COACD_RUNS
+    cold = model_from_spec(MIX, cache=cache, jobs=2)  # two CoACD links: the process pool
+    assert collision.COACD_RUNS - start == 2
+    reports = {link.name: link.collision_report for link in cold.links}
+    assert {n: r["method"] for n, r in reports.items()} == {
+        "base_link": "convex", "bracket": "coacd", "hub": "coacd", "finger": "primitives"}
+    assert reports["base_link"]["pieces"] == 10  # 13 primitives merged greedily
+    for link in cold.links:
+        if link.name != "finger":
+            assert 1 <= len(link.collision) <= 10
+            assert all(_trimesh(p).is_convex for p in link.collision), link.name
+            assert link.collision_report["coverage"] > 0.999
+    assert cold.link("finger").collision == ()
+    assert cold.derived["seeds"]["coacd"] == cold.seed
+
+    start = collision.COACD_RUNS
+    warm = model_from_spec(MIX, cache=Cache.at(tmp_path / "cache"), jobs=2)
+    assert collision.COACD_RUNS - start == 0
+    assert _pieces(warm) == _pieces(cold)
+    assert [link.collision_report for link in warm.links] == list(reports.values())
+
+    keys = {link.name: linkwork._collision_key(link, cold.seed) for link in cold.links}
+    hub = cache.path(linkwork.COLLISION_STEP, keys["hub"])
+    data = bytearray(hub.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    hub.write_bytes(bytes(data))
+    cache.path(linkwork.COLLISION_STEP, keys["bracket"]).unlink()
+    again_cache = Cache.at(tmp_path / "cache")
+    start = collision.COACD_RUNS
+    repaired = model_from_spec(MIX, cache=again_cache, jobs=1)
+    assert collision.COACD_RUNS - start == 2
+    assert again_cache.stats.repaired == {"collision": 1}
+    assert _pieces(repaired) == _pieces(cold)  # seeded CoACD: the same pieces again
+    assert Cache.at(tmp_path / "cache").get(linkwork.COLLISION_STEP, keys["hub"]) is not None
+
+
+def test_urdf_and_mjcf_reference_the_pieces(kit_factory):
+    import mujoco
+
+    kit = kit_factory(MIX).kit_dir
+    doc = json.loads((kit / "robot.json").read_text())
+    model = mujoco.MjModel.from_xml_path(str(kit / doc["files"]["mjcf"]))
+    urdf = (kit / doc["files"]["urdf"]).read_text()
+    for link in doc["links"]:
+        body = model.body(link["name"]).id
+        geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body
+                 and model.geom_group[g] == 3]
+        expected = len(link["mesh"]["collision"]) or 1  # finger: one capsule primitive
+        assert len(geoms) == expected, link["name"]
+        assert all(model.geom_contype[g] for g in geoms)
+        for path in link["mesh"]["collision"]:
+            assert f'filename="../{path}"' in urdf
+    finger = model.body("finger").id
+    kinds = [model.geom_type[g] for g in range(model.ngeom)
+             if model.geom_bodyid[g] == finger and model.geom_group[g] == 3]
+    assert kinds == [mujoco.mjtGeom.mjGEOM_CAPSULE]

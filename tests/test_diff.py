@@ -1,0 +1,135 @@
+"""`simkit diff`: semantic report of what changed between two kits."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from simkit.cli import main
+from simkit.diff import diff_kits, to_markdown
+from simkit.stl import from_stl, to_stl
+
+
+@pytest.fixture()
+def copy(rosie_1000, tmp_path):
+    """A private copy of the shared kit, to modify."""
+    target = tmp_path / "new"
+    shutil.copytree(rosie_1000.kit_dir, target)
+    return target
+
+
+def _edit_json(kit, change) -> None:
+    path = kit / "robot.json"
+    doc = json.loads(path.read_text())
+    change(doc)
+    path.write_text(json.dumps(doc, indent=2) + "\n")
+
+
+def _key(c) -> tuple:
+    return (c.kind, c.name, c.change, c.field)
+
+
+def test_kit_against_itself_and_its_zip_is_equal(rosie_1000):
+    runner = CliRunner()
+    for other in (rosie_1000.kit_dir, rosie_1000.zip_path):
+        result = runner.invoke(main, ["diff", str(rosie_1000.kit_dir), str(other)])
+        assert result.exit_code == 0, result.output
+        assert "No changes" in result.output
+    args = ["diff", "--json", str(rosie_1000.zip_path), str(rosie_1000.kit_dir)]
+    result = runner.invoke(main, args)
+    doc = json.loads(result.output)
+    assert result.exit_code == 0 and doc["equal"] and doc["changes"] == []
+
+
+def test_one_limit_and_one_mass_change_report_exactly_those_two(rosie_1000, copy):
+    def change(doc):
+        doc["joints"][1]["upper"] = 2.0  # joint_2, rad
+        doc["links"][2]["mass"] = 11.0  # link_2, kg
+
+    _edit_json(copy, change)
+    report = diff_kits(rosie_1000.kit_dir, copy)
+    assert [_key(c) for c in report.changes] == [
+        ("joint", "joint_2", "modified", "upper"),
+        ("link", "link_2", "modified", "mass"),
+    ]
+    joint, link = report.changes
+    assert (joint.new, joint.unit) == (2.0, "rad") and joint.old == pytest.approx(np.radians(135))
+    assert (link.old, link.new, link.unit) == (10.4, 11.0, "kg")
+    assert report.changed == ["robot.json"] and not report.added and not report.removed
+    text = to_markdown(report)
+    assert (
+        "| `joint_2` | upper | 2.35619 rad (135 deg) | 2 rad (114.59 deg) | -0.356194 rad" in text
+    )
+    assert "| `link_2` | mass | 10.4 kg | 11 kg | +0.6 kg, 5.77 % |" in text
+    result = CliRunner().invoke(main, ["diff", "--json", str(rosie_1000.kit_dir), str(copy)])
+    assert result.exit_code == 1
+    assert len(json.loads(result.output)["changes"]) == 2
+
+
+def test_each_kind_of_change(rosie_1000, copy):
+    def change(doc):
+        j1, j3 = doc["joints"][0], doc["joints"][2]
+        j1["max_velocity"] = 3.0
+        j1["effort_peak"] = 300.0
+        j3["lower"] = -2.0
+        j3["drive_peak_torque_at_joint"] = 200.0
+        doc["links"][1]["com"] = [0.0, 0.0, 0.06]
+        doc["links"][1]["inertia"]["ixx"] = 0.05
+        doc["links"].append(dict(doc["links"][-1], name="link_7"))
+        doc["fixed_joints"] = []  # base_joint removed
+        doc["payload"]["rated"] = 12.0
+
+    _edit_json(copy, change)
+    # link_4's visual mesh scaled by 1.1: volume x 1.331, bounding box x 1.1
+    stl = copy / "meshes" / "visual" / "link_4.stl"
+    mesh = from_stl(stl.read_bytes())
+    stl.write_bytes(to_stl(type(mesh).of(mesh.vertices * 1.1, mesh.faces), "link_4"))
+    # one more convex piece for link_1, and README removed
+    pieces = sorted((copy / "meshes" / "collision").glob("link_1_*.stl"))
+    shutil.copy(pieces[0], copy / "meshes" / "collision" / f"link_1_{len(pieces):02d}.stl")
+    (copy / "README.md").unlink()
+
+    report = diff_kits(rosie_1000.kit_dir, copy)
+    keys = {_key(c) for c in report.changes}
+    assert keys >= {
+        ("joint", "joint_1", "modified", "max_velocity"),
+        ("joint", "joint_1", "modified", "effort_peak"),
+        ("joint", "joint_3", "modified", "lower"),
+        ("joint", "joint_3", "modified", "drive_peak_torque_at_joint"),
+        ("joint", "base_joint", "removed", ""),
+        ("link", "link_1", "modified", "com"),
+        ("link", "link_1", "modified", "inertia"),
+        ("link", "link_7", "added", ""),
+        ("mesh", "meshes/visual/link_4.stl", "modified", "volume"),
+        ("mesh", "meshes/visual/link_4.stl", "modified", "bbox"),
+        ("collision", "link_1", "modified", "pieces"),
+        ("robot_json", "payload", "modified", ""),
+    }
+    extra = keys - {k for k in keys if k[0] != "mesh" and k[0] != "collision"}
+    assert extra <= {
+        ("mesh", "meshes/visual/link_4.stl", "modified", f) for f in ("volume", "bbox")
+    } | {("collision", "link_1", "modified", "pieces")}
+    by_key = {_key(c): c for c in report.changes}
+    volume = by_key[("mesh", "meshes/visual/link_4.stl", "modified", "volume")]
+    assert volume.new / volume.old == pytest.approx(1.331, rel=1e-5) and volume.unit == "m^3"
+    box = by_key[("mesh", "meshes/visual/link_4.stl", "modified", "bbox")]
+    assert np.allclose(np.array(box.new) / np.array(box.old), 1.1, rtol=1e-5)
+    pieces_change = by_key[("collision", "link_1", "modified", "pieces")]
+    assert pieces_change.new == pieces_change.old + 1
+    assert report.added == [f"meshes/collision/link_1_{len(pieces):02d}.stl"]
+    assert report.removed == ["README.md"]
+    assert set(report.changed) == {"robot.json", "meshes/visual/link_4.stl"}
+    text = to_markdown(report)
+    for heading in ("## Joints", "## Links", "## Meshes", "## Collision pieces", "## Files"):
+        assert heading in text
+    assert "`link_7` added" in text and "`base_joint` removed" in text
+    assert "(deg/s)" not in text and "deg/s)" in text  # speeds shown in rad/s and deg/s
+
+
+def test_missing_kit_is_one_line_error(tmp_path):
+    result = CliRunner().invoke(main, ["diff", str(tmp_path / "nope"), str(tmp_path)])
+    assert result.exit_code == 2 and "no such kit" in result.output

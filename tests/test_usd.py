@@ -1,0 +1,188 @@
+"""USD output: validators, agreement with the MJCF, byte-identical rebuilds, and a corrupted
+file failing the check."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from simkit.build import build, model_from_spec
+from simkit.check.kit import Kit
+from simkit.check.usd_check import check_usd, usd_path
+from simkit.check.usd_read import joints_from_parser, joints_from_schemas, parse_physics
+from simkit.cli import main
+from simkit.emit import usd
+
+SPECS = Path(__file__).resolve().parent / "specs"
+USDA = "usd/rosie_1000.usda"
+KEY_CHECKS = (
+    "usd.validate",
+    "usd.stage",
+    "usd.articulation",
+    "usd.mass",
+    "usd.com",
+    "usd.inertia",
+    "usd.joint_frames",
+    "usd.axes",
+    "usd.limits",
+    "usd.drive.stiffness",
+    "usd.colliders",
+    "usd.filtered_pairs",
+    "usd.fk",
+    "usd.fk.rotation",
+    "usd.xforms",
+)
+
+
+def _failed(findings) -> list[str]:
+    return [f.line() for f in findings if not f.ok]
+
+
+@pytest.fixture(scope="module")
+def mix_kit(tmp_path_factory):
+    """A made-up robot with a floating base, prismatic/continuous joints, negative and oblique
+    axes and collision primitives, built without the other checks (only the USD is tested)."""
+    return build(str(SPECS / "usd_mix.yaml"), tmp_path_factory.mktemp("usd_mix"), check=False)
+
+
+def test_rosie_usd_passes_its_checks(rosie_1000):
+    assert (rosie_1000.kit_dir / USDA).is_file()
+    found = {f.check: f for f in rosie_1000.findings if f.check.startswith("usd.")}
+    for name in KEY_CHECKS:
+        assert name in found and found[name].ok, name
+    with zipfile.ZipFile(rosie_1000.zip_path) as archive:
+        assert f"rosie_1000_description/{USDA}" in archive.namelist()
+
+
+def test_stage_layout(rosie_1000):
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    stage = Usd.Stage.Open(str(rosie_1000.kit_dir / USDA))
+    assert UsdGeom.GetStageUpAxis(stage) == "Z"
+    assert UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    assert UsdPhysics.GetStageKilogramsPerUnit(stage) == 1.0
+    top = stage.GetDefaultPrim()
+    assert top.HasAPI(UsdPhysics.ArticulationRootAPI)
+    base = UsdPhysics.FixedJoint(stage.GetPrimAtPath("/rosie_1000/joints/base_joint"))
+    assert [str(t) for t in base.GetBody0Rel().GetTargets()] == ["/rosie_1000"]
+    j1 = UsdPhysics.RevoluteJoint(stage.GetPrimAtPath("/rosie_1000/joints/joint_1"))
+    assert j1.GetAxisAttr().Get() == "Z"
+    assert j1.GetLowerLimitAttr().Get() == -270 and j1.GetUpperLimitAttr().Get() == 270
+    drive = UsdPhysics.DriveAPI.Get(j1.GetPrim(), "angular")
+    # kp = effort_peak / 0.01 rad = 33000 N m/rad -> per degree
+    assert drive.GetStiffnessAttr().Get() == pytest.approx(33000 * np.pi / 180, rel=1e-6)
+    visual = UsdGeom.Mesh(stage.GetPrimAtPath("/rosie_1000/link_2/visuals/link_2"))
+    assert len(visual.GetNormalsAttr().Get()) == len(visual.GetFaceVertexIndicesAttr().Get())
+    collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
+    assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
+    text = (rosie_1000.kit_dir / USDA).read_text(encoding="utf-8")
+    assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
+
+
+def test_rebuild_is_byte_identical(rosie_1000):
+    written = (rosie_1000.kit_dir / USDA).read_bytes()
+    assert usd.emit(model_from_spec("rosie_1000"))[USDA] == written
+    robot = model_from_spec("rosie_1000")
+    assert usd.emit(robot)[USDA] == written
+    assert usd.emit_binary(robot) == usd.emit_binary(robot)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "check"),
+    [
+        ("float physics:mass = 7.2\n", "float physics:mass = 7.3\n", "usd.mass"),
+        ('uniform token physics:axis = "Y"', 'uniform token physics:axis = "Z"', "usd.axes"),
+        ("float physics:upperLimit = 135\n", "float physics:upperLimit = 136\n", "usd.limits"),
+    ],
+)
+def test_corrupted_usd_fails(rosie_1000, tmp_path, old, new, check):
+    kit = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, kit)
+    text = (kit / USDA).read_text(encoding="utf-8")
+    assert old in text
+    (kit / USDA).write_text(text.replace(old, new, 1), encoding="utf-8")
+    failed = {f.check for f in check_usd(Kit.open(kit)) if not f.ok}
+    assert check in failed
+
+
+def test_missing_usd_fails(rosie_1000, tmp_path):
+    kit = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, kit)
+    (kit / USDA).unlink()
+    assert [f.check for f in check_usd(Kit.open(kit)) if not f.ok] == ["usd.present"]
+
+
+def test_usdc_build(tmp_path):
+    result = CliRunner().invoke(
+        main,
+        ["build", "rosie_1000", "--out", str(tmp_path), "--usd-format", "usdc", "--no-check", "-q"],
+    )
+    assert result.exit_code == 0, result.output
+    kit = tmp_path / "rosie_1000_description"
+    assert not (kit / USDA).exists()
+    assert (kit / "usd/rosie_1000.usdc").read_bytes().startswith(b"PXR-USDC")
+    assert usd_path(Kit.open(kit)).name == "rosie_1000.usdc"
+    assert _failed(check_usd(Kit.open(kit))) == []
+
+
+def test_generic_robot(mix_kit):
+    """Floating base (no joint to the world), prismatic and continuous joints, negative and
+    oblique axes, capsule/box/sphere/cylinder colliders: all agree with the MJCF."""
+    from pxr import Usd
+
+    findings = check_usd(Kit.open(mix_kit.kit_dir))
+    assert _failed(findings) == []
+    assert {"usd.primitives", "usd.fk", "usd.drive.damping"} <= {f.check for f in findings}
+    stage = Usd.Stage.Open(str(mix_kit.kit_dir / "usd/usd_mix.usda"))
+    assert not stage.GetPrimAtPath("/usd_mix/joints/float")
+    assert stage.GetPrimAtPath("/usd_mix/joints/slide").GetTypeName() == "PhysicsPrismaticJoint"
+    assert stage.GetPrimAtPath("/usd_mix/arm/collisions/collision_00").GetTypeName() == "Capsule"
+    assert stage.GetPrimAtPath("/usd_mix/body/collisions/collision_00").GetTypeName() == "Cube"
+
+
+def test_schema_reader_matches_parser(mix_kit):
+    """The attribute-by-attribute reader (usd-core without a physics parser) sees the same
+    joints as UsdPhysics' parser."""
+    from pxr import Usd
+
+    stage = Usd.Stage.Open(str(mix_kit.kit_dir / "usd/usd_mix.usda"))
+    parsed = parse_physics(stage)
+    assert parsed is not None
+    a = sorted(joints_from_parser(parsed), key=lambda j: j.path)
+    b = sorted(joints_from_schemas(stage), key=lambda j: j.path)
+    assert [(j.path, j.kind, j.body0, j.body1, j.limit, j.drive) for j in a] == [
+        (j.path, j.kind, j.body0, j.body1, j.limit, j.drive) for j in b
+    ]
+    for x, y in zip(a, b, strict=True):
+        assert np.allclose(x.pose0, y.pose0, atol=1e-6) and np.allclose(x.pose1, y.pose1, atol=1e-6)
+
+
+def test_principal_axes_round_trip():
+    tensor = np.array([[4e-4, 5e-5, -2e-5], [5e-5, 3e-4, 1e-5], [-2e-5, 1e-5, 2e-4]])
+    diag, rot = usd.principal_axes(tensor)
+    assert np.linalg.det(rot) == pytest.approx(1.0)
+    assert np.allclose(rot @ np.diag(diag) @ rot.T, tensor, atol=1e-15)
+    diag, rot = usd.principal_axes(np.diag([1.0, 2.0, 3.0]))
+    assert np.array_equal(rot, np.eye(3)) and list(diag) == [1.0, 2.0, 3.0]
+
+
+def test_readme_usd_snippet(rosie_1000):
+    readme = (rosie_1000.kit_dir / "README.md").read_text(encoding="utf-8")
+    assert "usdview usd/rosie_1000.usda" in readme and "UsdPhysics" in readme
+    code = readme.split("```python\nfrom pxr import Usd, UsdPhysics\n", 1)[1].split("```", 1)[0]
+    proc = subprocess.run(
+        [sys.executable, "-c", "from pxr import Usd, UsdPhysics\n" + code],
+        cwd=rosie_1000.kit_dir,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "joint_6 PhysicsRevoluteJoint" in proc.stdout
