@@ -101,7 +101,7 @@ def _content_digest(arrays: Arrays) -> str:
 
 def encode_json(value: object) -> np.ndarray:
     """JSON data as a uint8 array, so metadata travels in the npz without pickle."""
-    return np.frombuffer(json.dumps(value, sort_keys=True).encode("utf-8"), dtype=np.uint8)
+    return np.frombuffer(json.dumps(value).encode("utf-8"), dtype=np.uint8)
 
 
 def decode_json(arr: np.ndarray) -> object:
@@ -273,14 +273,56 @@ def derived_step(robot, cache: Cache, name: str, step: Callable):
                    ("numpy", "mujoco", "manifold3d"))
     found = cache.get(f"derived_{name}", key)
     if found is not None:
-        return replace(robot, derived={**robot.derived, **decode_json(found["derived"])})  # type: ignore[dict-item]
+        extra = _join(decode_json(found["derived"]), found)
+        return replace(robot, derived={**robot.derived, **extra})  # type: ignore[dict-item]
     out = step(robot)
     changed = {k: v for k, v in out.derived.items()
                if k not in robot.derived or robot.derived[k] is not v}
+    arrays: Arrays = {}
     try:
-        exact = json.loads(json.dumps(changed, sort_keys=True)) == changed
+        skeleton = _split(changed, arrays)
+        exact = json.loads(json.dumps(skeleton)) == skeleton
     except (TypeError, ValueError):
         exact = False
     if exact and replace(out, derived=robot.derived) == robot:
-        cache.put(f"derived_{name}", key, {"derived": encode_json(changed)})
+        cache.put(f"derived_{name}", key, {"derived": encode_json(skeleton), **arrays})
     return out
+
+
+_ARRAY = "__ndarray__"
+
+
+def _split(value: object, arrays: Arrays) -> object:
+    """JSON skeleton of `value` with each numpy array moved into `arrays` (raises TypeError
+    for anything JSON cannot hold exactly, such as tuples)."""
+    if isinstance(value, np.ndarray):
+        if value.dtype.hasobject:
+            raise TypeError("object array")
+        name = f"a{len(arrays)}"
+        arrays[name] = value
+        return {_ARRAY: name}
+    if isinstance(value, dict):
+        if not all(isinstance(k, str) for k in value) or _ARRAY in value:
+            raise TypeError("keys")
+        return {k: _split(v, arrays) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_split(v, arrays) for v in value]
+    if value is None or type(value) in (bool, int, float, str):
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating) and value.dtype == np.float64:
+        return float(value)  # the same double; emitters format both alike
+    raise TypeError(type(value).__name__)
+
+
+def _join(value: object, arrays: Mapping[str, np.ndarray]) -> object:
+    if isinstance(value, dict):
+        if set(value) == {_ARRAY}:
+            return arrays[value[_ARRAY]]
+        return {k: _join(v, arrays) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_join(v, arrays) for v in value]
+    return value

@@ -7,7 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit import collision_pairs, dynamics, inertia_decision, linkwork, massprops, motion
+from simkit import (
+    collision_pairs,
+    dynamics,
+    freefall,
+    inertia_decision,
+    linkwork,
+    massprops,
+    motion,
+)
 from simkit.cache import Cache, derived_step
 from simkit.kinematics import forward
 from simkit.model import Robot
@@ -82,4 +90,6 @@ def derive_all(robot: Robot, base_dir: Path, cache: Cache | None = None, jobs: i
     # last: samples the final collision geometry
     robot = derived_step(robot, cache, "collision_pairs", collision_pairs.derive_collision_pairs)
     # motion data after the servos: its inverse-dynamics check reads the final MJCF
-    return derived_step(robot, cache, "motion", motion.derive_motion)
+    robot = derived_step(robot, cache, "motion", motion.derive_motion)
+    # free-fall validation (spec `freefall:`) last: it simulates the files the final model emits
+    return derived_step(robot, cache, "freefall", freefall.derive_freefall)

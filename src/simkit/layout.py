@@ -81,6 +81,20 @@ def asset_dir(robot: str, declared: str | None = None) -> str:
     return declared or robot
 
 
+#: ros2_control (emit/ros2_control.py): controller settings and the Gazebo launch file.
+CONTROLLERS_YAML = "config/controllers.yaml"
+GAZEBO_LAUNCH = "launch/gazebo.launch.py"
+
+
+def freefall_csv() -> str:
+    """Free-fall trajectories (freefall.py), one column per run, simulation and joint."""
+    return "validation/freefall.csv"
+
+
+def freefall_plot() -> str:
+    return "validation/freefall.png"
+
+
 def relative(from_file: str, to_file: str) -> str:
     """Path of `to_file` as seen from the folder of `from_file` (e.g. `../meshes/...`)."""
     return posixpath.relpath(to_file, posixpath.dirname(from_file) or ".")

@@ -24,7 +24,7 @@ from simkit.model import Link, Mesh, Robot
 Progress = Callable[[str], None]
 
 SOLID_STEP, SOLID_VERSION = "link_solid", 1
-COLLISION_STEP, COLLISION_VERSION = "collision", 2
+COLLISION_STEP, COLLISION_VERSION = "collision", 3
 
 
 def default_jobs() -> int:
