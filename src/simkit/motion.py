@@ -14,7 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from simkit import dynamics, layout
+from simkit import dynamics, ik, ik_cases, layout
 from simkit.ik import ArmChain
 from simkit.model import Robot
 
@@ -169,24 +169,63 @@ def motion_block(robot: Robot, arm: ArmChain) -> tuple[dict, dict]:
 
 
 def derive_motion(robot: Robot) -> Robot:
-    """Derive step: accelerations and `motion`, the benchmark cycles (`benchmarks`, the 1 kg
-    trajectory) and the IK reference cases (`ik_reference`, ik_cases.json) for a
-    wrist-partitioned 6R arm with speeds and torques; any other robot is returned unchanged.
+    """Derive step for a wrist-partitioned 6R arm (`ik.arm_chain`); any other robot is
+    returned unchanged. Adds the IK reference cases (`ik_reference`, ik_cases.json); with
+    torques, speeds and the stretched and work poses, the accelerations (`motion`,
+    joints[].derived_max_acceleration); with servos on every joint, the benchmark cycles
+    (`benchmarks`, the 1 kg trajectory).
 
     Runs after the servos are derived: the benchmark's inverse-dynamics check reads the
     MJCF that the final model emits."""
-    # Imported here: benchmark builds on this module's accelerations, and derive imports us.
-    from simkit import benchmark, ik, ik_cases
-    from simkit.derive import with_json
-    from simkit.emit import mjcf
-
     arm = ik.arm_chain(robot)
-    if arm is None or "stretched" not in dict(robot.poses) or "work" not in dict(robot.poses):
+    if arm is None:
         return robot
+    robot = _derive_ik_cases(robot, arm)
     joints = [robot.joint(n) for n in arm.names]
     if any(j.effort_peak is None or j.max_velocity is None for j in joints):
         return robot
+    if not {"stretched", "work"} <= dict(robot.poses).keys():
+        return robot
+    robot = _derive_accelerations(robot, arm)
+    if {a.joint for a in robot.actuators} >= set(arm.names):
+        robot = _derive_benchmark(robot, arm)
+    return robot
+
+
+def _derive_ik_cases(robot: Robot, arm: ArmChain) -> Robot:
+    from simkit.derive import with_json  # derive imports this module
+
+    cases = ik_cases.cases_document(robot, arm)
+    seeds = {**robot.derived.get("seeds", {}), "ik_cases": robot.seed}
+    robot = replace(robot, derived={**robot.derived, "ik_cases": cases, "seeds": seeds})
+    reference = {
+        "file": layout.IK_CASES,
+        "cases": len(cases["cases"]),
+        "chain": {"base": arm.base, "tip": arm.tool, "joints": list(arm.names)},
+        "solver": {k: cases["solver"][k] for k in ("name", "method", "provenance")},
+        "branch_flags": ik.BRANCH_FLAGS,
+        "tolerance": ik_cases.TOLERANCE,
+    }
+    return with_json(robot, "ik_reference", reference)
+
+
+def _derive_accelerations(robot: Robot, arm: ArmChain) -> Robot:
+    from simkit.derive import with_json  # derive imports this module
+
     block, per_joint = motion_block(robot, arm)
+    joint_json = {**robot.derived.get("joint_json", {})}
+    for name, extra in per_joint.items():
+        joint_json[name] = {**joint_json.get(name, {}), **extra}
+    robot = replace(robot, derived={**robot.derived, "joint_json": joint_json})
+    return with_json(robot, "motion", block)
+
+
+def _derive_benchmark(robot: Robot, arm: ArmChain) -> Robot:
+    # benchmark and derive import this module; the emitter package imports every emitter
+    from simkit import benchmark
+    from simkit.derive import with_json
+    from simkit.emit import mjcf
+
     cycles = [
         benchmark.cycle(robot, arm, "cycle_1kg", WORK_PAYLOAD),
         benchmark.cycle(robot, arm, "cycle_rated", rated_payload(robot)),
@@ -204,31 +243,6 @@ def derive_motion(robot: Robot) -> Robot:
         )
         for c in cycles
     }
-    cases = ik_cases.cases_document(robot, arm)
-    joint_json = {**robot.derived.get("joint_json", {})}
-    for name, extra in per_joint.items():
-        joint_json[name] = {**joint_json.get(name, {}), **extra}
-    robot = replace(
-        robot,
-        derived={
-            **robot.derived,
-            "joint_json": joint_json,
-            "benchmark_trajectory": benchmark.trajectory_data(robot, arm, cycles[0]),
-            "ik_cases": cases,
-            "seeds": {**robot.derived.get("seeds", {}), "ik_cases": robot.seed},
-        },
-    )
-    robot = with_json(robot, "motion", block)
-    robot = with_json(robot, "benchmarks", benchmark.benchmarks_block(robot, arm, cycles, checks))
-    return with_json(
-        robot,
-        "ik_reference",
-        {
-            "file": layout.IK_CASES,
-            "cases": len(cases["cases"]),
-            "chain": {"base": arm.base, "tip": arm.tool, "joints": list(arm.names)},
-            "solver": {k: cases["solver"][k] for k in ("name", "method", "provenance")},
-            "branch_flags": ik.BRANCH_FLAGS,
-            "tolerance": ik_cases.TOLERANCE,
-        },
-    )
+    trajectory = benchmark.trajectory_data(robot, arm, cycles[0])
+    robot = replace(robot, derived={**robot.derived, "benchmark_trajectory": trajectory})
+    return with_json(robot, "benchmarks", benchmark.benchmarks_block(robot, arm, cycles, checks))

@@ -22,9 +22,9 @@ from simkit.model import Robot
 
 GRAVITY = 9.81  # m/s^2, MuJoCo's default |gravity|
 #: rad/s: below this speed Coulomb friction fades linearly to zero (tanh regularisation).
-FRICTION_SPEED = 1e-4
+FRICTION_SPEED = 1e-3
 #: solve_ivp tolerances: global error far below the 1e-3 rad comparison bound.
-RTOL, ATOL = 1e-10, 1e-12
+RTOL, ATOL = 1e-9, 1e-11
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

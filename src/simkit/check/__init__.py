@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from simkit.check.findings import Finding
+from simkit.check.freefall_check import check_freefall
 from simkit.check.geometry_check import check_collision, check_glb
 from simkit.check.kit import Kit
 from simkit.check.legged_check import check_legged
@@ -32,6 +33,7 @@ CHECKS: dict[str, Check] = {
     "legged": check_legged,
     "usd": check_usd,
     "motion": check_motion,
+    "freefall": check_freefall,
 }
 
 

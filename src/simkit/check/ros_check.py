@@ -71,7 +71,8 @@ def _srdf(kit: Kit) -> list[Finding]:
     links = {link.get("name") for link in urdf.iter("link")}
     solid = {link.get("name") for link in urdf.iter("link") if link.find("collision") is not None}
     limits = {}
-    for joint in urdf.iter("joint"):
+    # top-level joints only: <transmission> and <ros2_control> nest <joint> elements too
+    for joint in urdf.findall("joint"):
         limit = joint.find("limit")
         if limit is not None and limit.get("lower") is not None:
             limits[joint.get("name")] = (float(limit.get("lower")), float(limit.get("upper")))
@@ -99,7 +100,7 @@ def _srdf(kit: Kit) -> list[Finding]:
     }
     adjacent = {
         frozenset((j.find("parent").get("link"), j.find("child").get("link")))
-        for j in urdf.iter("joint")
+        for j in urdf.findall("joint")
     }
     missing = sorted(tuple(sorted(p)) for p in adjacent if p <= solid and p not in disabled)
     return [

@@ -13,6 +13,7 @@ from simkit.emit import usd
 from simkit.emit import motion_files
 from simkit.emit import glb
 from simkit.emit import mjcf_scene
+from simkit.emit import ros2_control, validation
 from simkit.model import Robot
 
 Emitter = Callable[[Robot], dict[str, bytes]]
@@ -30,6 +31,8 @@ EMITTERS: dict[str, Emitter] = {
     "usd": usd.emit,
     "motion_files": motion_files.emit,
     "glb": glb.emit,
+    "ros2_control": ros2_control.emit,
+    "validation": validation.emit,
 }
 
 

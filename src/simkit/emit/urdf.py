@@ -7,6 +7,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from simkit import layout
+from simkit.emit import ros2_control
 from simkit.fmt import num, vec
 from simkit.kinematics import rpy_matrix
 from simkit.model import Joint, Link, Robot, Shape
@@ -117,4 +118,5 @@ def emit(robot: Robot) -> dict[str, bytes]:
         sub(joint, "child", link=frame.name)
         _origin(joint, frame.xyz, frame.rpy)
         sub(root, "link", name=frame.name)
+    root.extend(ros2_control.urdf_elements(robot))  # spec `ros2_control:` only; else nothing
     return {file: to_bytes(root, HEADER.format(spec=robot.spec_file))}

@@ -40,7 +40,7 @@ def plot_png(robot: Robot, data: dict) -> bytes:
     from matplotlib.figure import Figure
 
     joints, sides = data["joints"], data["trajectories"][PLOTTED_RUN]
-    fig = Figure(figsize=(8.0, 2.4 * len(joints) + 1.0), dpi=100)
+    fig = Figure(figsize=(8.0, 2.4 * len(joints) + 1.4), dpi=100)
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(joints), 1, sharex=True, squeeze=False)[:, 0]
     for k, (ax, joint) in enumerate(zip(axes, joints, strict=True)):
@@ -52,11 +52,10 @@ def plot_png(robot: Robot, data: dict) -> bytes:
     axes[0].legend(loc="upper right", fontsize=8)
     figs = data["figures"]
     lines = [
-        f"{robot.title}: free fall from rest, {PLOTTED_RUN} run",
-        "RMS difference (rad): " + ", ".join(
-            f"{run}: " + " / ".join(num(figs[run][pair]["rms"], 2) for pair in figs[run])
-            for run in figs
-        ) + f"  (MJCF-indep. / URDF-indep. / MJCF-URDF; bound {num(data['tolerance_rms'], 3)})",
+        f"{robot.title}: free fall from rest, {num(data['t'][-1], 3)} s ({PLOTTED_RUN} run shown)",
+        "joint-angle RMS difference (rad), MJCF vs indep. / URDF vs indep. / MJCF vs URDF:",
+        "; ".join(f"{run} " + " / ".join(num(figs[run][pair]["rms"], 2) for pair in figs[run])
+                  for run in figs) + f"; bound {num(data['tolerance_rms'], 3)}",
     ]
     fig.suptitle("\n".join(lines), fontsize=9)
     fig.tight_layout()

@@ -1,0 +1,102 @@
+"""Time `simkit build` per robot, cold (empty cache) and warm (cache hit), as issue 3 asks.
+
+For each robot: one cold build into an empty cache folder, then `--warm` warm rebuilds (the
+median is reported), each as its own `simkit build` process, so interpreter start-up and
+imports count as a user sees them. Also reported: the CoACD share of the cold build (seconds
+of the links CoACD decomposed, from the build's plain log lines, over the cold wall time),
+collision pieces, and visual and collision triangles.
+
+    python scripts/bench.py                      # every robots/rosie_*.yaml
+    python scripts/bench.py rosie_1000 tests/specs/collision_mix.yaml --warm 5 --json out.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+LOG = re.compile(r"collision (\S+): (\w+), (\d+) pieces, ([\d.]+) s")
+
+
+def _build(target: str, out: Path, cache: Path, jobs: int | None) -> tuple[float, str]:
+    cmd = [sys.executable, "-m", "simkit.cli", "build", target, "--out", str(out),
+           "--cache-dir", str(cache)]
+    if jobs:
+        cmd += ["--jobs", str(jobs)]
+    start = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - start
+    if done.returncode != 0:
+        raise SystemExit(f"{target}: build failed:\n{done.stderr}")
+    return wall, done.stderr
+
+
+def _triangles(path: Path) -> int:
+    return int.from_bytes(path.read_bytes()[80:84], "little")
+
+
+def bench(target: str, warm_runs: int, jobs: int | None) -> dict:
+    with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
+        root = Path(tmp)
+        cold, log = _build(target, root / "out", root / "cache", jobs)
+        warm = [_build(target, root / "out", root / "cache", jobs)[0] for _ in range(warm_runs)]
+        coacd = sum(float(m[3]) for m in LOG.findall(log) if m[1] == "coacd")
+        kit = next((root / "out").glob("*_description"))
+        doc = json.loads((kit / "robot.json").read_text())
+        visual = sum(_triangles(kit / link["mesh"]["visual"]) for link in doc["links"]
+                     if link["mesh"]["visual"])
+        collision = sum(_triangles(kit / p) for link in doc["links"] for p in link["mesh"]["collision"])
+        reports = [g["collision"] for g in doc["geometry"]["links"]]
+    return {
+        "robot": doc["name"],
+        "cold_s": cold,
+        "warm_s": statistics.median(warm),
+        "warm_runs_s": warm,
+        "coacd_links": sum(r["method"] == "coacd" for r in reports),
+        "coacd_s": coacd,
+        "coacd_share": coacd / cold,
+        "pieces": sum(r["pieces"] for r in reports),
+        "max_pieces_per_link": max(r["pieces"] for r in reports),
+        "max_hull_volume_ratio": max(r["hull_volume_ratio"] for r in reports if "hull_volume_ratio" in r),
+        "max_visual_to_collision_mm": 1000 * max(r.get("visual_to_collision_max_m", 0.0) for r in reports),
+        "visual_triangles": visual,
+        "collision_triangles": collision,
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("targets", nargs="*", help="robot names or spec paths (default: rosie_*)")
+    parser.add_argument("--warm", type=int, default=3, help="warm rebuilds per robot (median)")
+    parser.add_argument("--jobs", type=int, default=None, help="passed to simkit build --jobs")
+    parser.add_argument("--json", type=Path, default=None, help="also write the rows here")
+    args = parser.parse_args()
+    targets = args.targets
+    if not targets:
+        from simkit.resources import robot_names
+
+        targets = [n for n in robot_names() if n.startswith("rosie_")]
+    rows = [bench(t, args.warm, args.jobs) for t in targets]
+    print(f"cores: {len(os.sched_getaffinity(0))}, python {sys.version.split()[0]}")
+    print("| robot | cold s | warm s | CoACD links | CoACD share | pieces (max/link) | "
+          "max hull/solid | max visual-to-collision mm | visual tris | collision tris |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['robot']} | {r['cold_s']:.2f} | {r['warm_s']:.2f} | {r['coacd_links']} | "
+              f"{100 * r['coacd_share']:.0f} % | {r['pieces']} ({r['max_pieces_per_link']}) | "
+              f"{r['max_hull_volume_ratio']:.3f} | {r['max_visual_to_collision_mm']:.2f} | "
+              f"{r['visual_triangles']} | {r['collision_triangles']} |")
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
