@@ -27,8 +27,17 @@ LOG = re.compile(r"collision (\S+): (\w+), (\d+) pieces, ([\d.]+) s")
 
 
 def _build(target: str, out: Path, cache: Path, jobs: int | None) -> tuple[float, str]:
-    cmd = [sys.executable, "-m", "simkit.cli", "build", target, "--out", str(out),
-           "--cache-dir", str(cache)]
+    cmd = [
+        sys.executable,
+        "-m",
+        "simkit.cli",
+        "build",
+        target,
+        "--out",
+        str(out),
+        "--cache-dir",
+        str(cache),
+    ]
     if jobs:
         cmd += ["--jobs", str(jobs)]
     start = time.perf_counter()
@@ -51,9 +60,14 @@ def bench(target: str, warm_runs: int, jobs: int | None) -> dict:
         coacd = sum(float(m[3]) for m in LOG.findall(log) if m[1] == "coacd")
         kit = next((root / "out").glob("*_description"))
         doc = json.loads((kit / "robot.json").read_text())
-        visual = sum(_triangles(kit / link["mesh"]["visual"]) for link in doc["links"]
-                     if link["mesh"]["visual"])
-        collision = sum(_triangles(kit / p) for link in doc["links"] for p in link["mesh"]["collision"])
+        visual = sum(
+            _triangles(kit / link["mesh"]["visual"])
+            for link in doc["links"]
+            if link["mesh"]["visual"]
+        )
+        collision = sum(
+            _triangles(kit / p) for link in doc["links"] for p in link["mesh"]["collision"]
+        )
         reports = [g["collision"] for g in doc["geometry"]["links"]]
     return {
         "robot": doc["name"],
@@ -65,8 +79,11 @@ def bench(target: str, warm_runs: int, jobs: int | None) -> dict:
         "coacd_share": coacd / cold,
         "pieces": sum(r["pieces"] for r in reports),
         "max_pieces_per_link": max(r["pieces"] for r in reports),
-        "max_hull_volume_ratio": max(r["hull_volume_ratio"] for r in reports if "hull_volume_ratio" in r),
-        "max_visual_to_collision_mm": 1000 * max(r.get("visual_to_collision_max_m", 0.0) for r in reports),
+        "max_hull_volume_ratio": max(
+            r["hull_volume_ratio"] for r in reports if "hull_volume_ratio" in r
+        ),
+        "max_visual_to_collision_mm": 1000
+        * max(r.get("visual_to_collision_max_m", 0.0) for r in reports),
         "visual_triangles": visual,
         "collision_triangles": collision,
     }
@@ -86,14 +103,18 @@ def main() -> None:
         targets = [n for n in robot_names() if n.startswith("rosie_")]
     rows = [bench(t, args.warm, args.jobs) for t in targets]
     print(f"cores: {len(os.sched_getaffinity(0))}, python {sys.version.split()[0]}")
-    print("| robot | cold s | warm s | CoACD links | CoACD share | pieces (max/link) | "
-          "max hull/solid | max visual-to-collision mm | visual tris | collision tris |")
+    print(
+        "| robot | cold s | warm s | CoACD links | CoACD share | pieces (max/link) | "
+        "max hull/solid | max visual-to-collision mm | visual tris | collision tris |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print(f"| {r['robot']} | {r['cold_s']:.2f} | {r['warm_s']:.2f} | {r['coacd_links']} | "
-              f"{100 * r['coacd_share']:.0f} % | {r['pieces']} ({r['max_pieces_per_link']}) | "
-              f"{r['max_hull_volume_ratio']:.3f} | {r['max_visual_to_collision_mm']:.2f} | "
-              f"{r['visual_triangles']} | {r['collision_triangles']} |")
+        print(
+            f"| {r['robot']} | {r['cold_s']:.2f} | {r['warm_s']:.2f} | {r['coacd_links']} | "
+            f"{100 * r['coacd_share']:.0f} % | {r['pieces']} ({r['max_pieces_per_link']}) | "
+            f"{r['max_hull_volume_ratio']:.3f} | {r['max_visual_to_collision_mm']:.2f} | "
+            f"{r['visual_triangles']} | {r['collision_triangles']} |"
+        )
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2) + "\n")
 

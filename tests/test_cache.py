@@ -102,3 +102,19 @@ def test_cli_cache_dir_and_no_cache(tmp_path):
     assert result.exit_code == 0, result.output
     assert len(list((on / "collision").rglob("*.npz"))) == 7
     assert len(list((on / "link_solid").rglob("*.npz"))) == 7
+
+
+def test_warm_derive_hits_every_step_and_emits_the_same_bytes(tmp_path):
+    """Link solids, collision pieces and the cached robot-level steps come back from the
+    cache, and the kit's files are byte-identical to the cold build's."""
+    from simkit.build import model_from_spec
+    from simkit.emit import emit_all
+
+    cold = emit_all(model_from_spec("rosie_1000", cache=Cache.at(tmp_path), jobs=1))
+    warm_cache = Cache.at(tmp_path)
+    warm = emit_all(model_from_spec("rosie_1000", cache=warm_cache, jobs=1))
+    assert "link_solid" not in warm_cache.stats.misses
+    assert "collision" not in warm_cache.stats.misses
+    assert warm_cache.stats.hits["link_solid"] == 7 and warm_cache.stats.hits["collision"] == 7
+    assert any(step.startswith("derived_") for step in warm_cache.stats.hits)
+    assert warm == cold

@@ -42,9 +42,13 @@ def _read(path: Path) -> dict:
 def _quat(q) -> np.ndarray:
     """Rotation matrix of a glTF (x, y, z, w) quaternion."""
     x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def _rodrigues(axis, angle) -> np.ndarray:
@@ -87,8 +91,12 @@ def _chain(doc: dict) -> list[str]:
 
 def test_rosie_nodes_follow_the_joint_chain_y_up(rosie_1000):
     doc = _read(rosie_1000.kit_dir / "glb" / "rosie_1000.glb")
-    assert _chain(doc)[1:] == ["base_footprint", "base_link", *[f"link_{i}" for i in range(1, 7)],
-                               "tool0"]
+    assert _chain(doc)[1:] == [
+        "base_footprint",
+        "base_link",
+        *[f"link_{i}" for i in range(1, 7)],
+        "tool0",
+    ]
     root = _quat(doc["nodes"][0]["rotation"])
     np.testing.assert_allclose(root @ [0, 0, 1], [0, 1, 0], atol=1e-9)  # Z-up turned Y-up
     robot = json.loads((rosie_1000.kit_dir / "robot.json").read_text())
@@ -129,7 +137,9 @@ def test_tree_materials_and_positions(kit_factory):
     _doc, binary = glb.read_glb((kit_dir / "glb" / "collision_mix.glb").read_bytes())
     accessor = doc["accessors"][mesh["attributes"]["POSITION"]]
     view = doc["bufferViews"][accessor["bufferView"]]
-    positions = np.frombuffer(binary, "<f4", accessor["count"] * 3, view["byteOffset"]).reshape(-1, 3)
+    positions = np.frombuffer(binary, "<f4", accessor["count"] * 3, view["byteOffset"]).reshape(
+        -1, 3
+    )
     from simkit.stl import from_stl
 
     visual = from_stl((kit_dir / "meshes" / "visual" / "bracket.stl").read_bytes()).vertices
@@ -138,7 +148,9 @@ def test_tree_materials_and_positions(kit_factory):
 
 def test_byte_identical_across_builds(rosie_1000):
     again = glb.emit(model_from_spec("rosie_1000"))
-    assert again["glb/rosie_1000.glb"] == (rosie_1000.kit_dir / "glb" / "rosie_1000.glb").read_bytes()
+    assert (
+        again["glb/rosie_1000.glb"] == (rosie_1000.kit_dir / "glb" / "rosie_1000.glb").read_bytes()
+    )
 
 
 def _validator_env() -> dict[str, str] | None:
@@ -147,8 +159,9 @@ def _validator_env() -> dict[str, str] | None:
         return None
     paths = [p for p in os.environ.get("NODE_PATH", "").split(os.pathsep) if p]
     env = {**os.environ, "NODE_PATH": os.pathsep.join([*paths, str(NODE_PREFIX / "node_modules")])}
-    probe = subprocess.run([node, "-e", "require.resolve('gltf-validator')"], env=env,
-                           capture_output=True, check=False)
+    probe = subprocess.run(
+        [node, "-e", "require.resolve('gltf-validator')"], env=env, capture_output=True, check=False
+    )
     return env if probe.returncode == 0 else None
 
 
@@ -162,11 +175,17 @@ def test_khronos_validator_reports_no_errors_for_every_kit(tmp_path):
     paths = []
     for target in targets:
         robot = model_from_spec(target)
-        (path, data), = glb.emit(robot).items()
+        ((_path, data),) = glb.emit(robot).items()
         paths.append(tmp_path / f"{robot.name}.glb")
         paths[-1].write_bytes(data)
-    result = subprocess.run(["node", "-e", VALIDATE_JS, *map(str, paths)], env=env,
-                            capture_output=True, text=True, check=True, timeout=300)
+    result = subprocess.run(
+        ["node", "-e", VALIDATE_JS, *map(str, paths)],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    )
     reports = json.loads(result.stdout)
     errors = {Path(p).name: r["messages"] for p, r in reports.items() if r["numErrors"]}
     assert len(reports) == len(targets) and not errors

@@ -71,8 +71,13 @@ def _canonical(value: object) -> object:
     raise TypeError(f"cache key cannot hold {type(value).__name__}")
 
 
-def make_key(step: str, version: int, inputs: list[bytes], params: Mapping[str, object],
-             libraries: tuple[str, ...] = ()) -> str:
+def make_key(
+    step: str,
+    version: int,
+    inputs: list[bytes],
+    params: Mapping[str, object],
+    libraries: tuple[str, ...] = (),
+) -> str:
     """SHA-256 hex key of the input bytes, step name and version, simkit and library versions,
     and every parameter."""
     h = hashlib.sha256()
@@ -269,15 +274,21 @@ def derived_step(robot, cache: Cache, name: str, step: Callable):
 
     if not cache.enabled:
         return step(robot)
-    key = make_key(f"derived_{name}", 1, [digest(robot).encode(), code_digest().encode()], {},
-                   ("numpy", "mujoco", "manifold3d"))
+    key = make_key(
+        f"derived_{name}",
+        1,
+        [digest(robot).encode(), code_digest().encode()],
+        {},
+        ("numpy", "mujoco", "manifold3d"),
+    )
     found = cache.get(f"derived_{name}", key)
     if found is not None:
         extra = _join(decode_json(found["derived"]), found)
         return replace(robot, derived={**robot.derived, **extra})  # type: ignore[dict-item]
     out = step(robot)
-    changed = {k: v for k, v in out.derived.items()
-               if k not in robot.derived or robot.derived[k] is not v}
+    changed = {
+        k: v for k, v in out.derived.items() if k not in robot.derived or robot.derived[k] is not v
+    }
     arrays: Arrays = {}
     try:
         skeleton = _split(changed, arrays)

@@ -58,9 +58,13 @@ def method_of(link: Link) -> str:
     if link.collision_method == "auto":
         return "convex" if is_convex_union(link.shapes) else "coacd"
     if link.collision_method == "convex" and not is_convex_union(link.shapes):
-        raise SpecError(link.name, None, "collision",
-                        f"link '{link.name}': 'convex' needs a union of convex primitives "
-                        "(no mesh, no subtract); use 'auto' or 'coacd'")
+        raise SpecError(
+            link.name,
+            None,
+            "collision",
+            f"link '{link.name}': 'convex' needs a union of convex primitives "
+            "(no mesh, no subtract); use 'auto' or 'coacd'",
+        )
     return link.collision_method
 
 
@@ -84,8 +88,12 @@ def key_params(link: Link, seed: int) -> dict[str, object]:
 def _manifold(mesh: Mesh):
     import manifold3d as mf
 
-    return mf.Manifold(mf.Mesh64(vert_properties=np.array(mesh.vertices, np.float64),
-                                 tri_verts=np.array(mesh.faces, np.uint64)))
+    return mf.Manifold(
+        mf.Mesh64(
+            vert_properties=np.array(mesh.vertices, np.float64),
+            tri_verts=np.array(mesh.faces, np.uint64),
+        )
+    )
 
 
 def _hull(points: np.ndarray):
@@ -119,12 +127,17 @@ def merge_greedy(hulls: list, limit: int = MAX_PIECES) -> list:
     def cost(a, b) -> float:
         return mf.Manifold.batch_hull([a, b]).volume() - (a + b).volume()
 
-    costs = {(i, j): cost(hulls[i], hulls[j])
-             for i in range(len(hulls)) for j in range(i + 1, len(hulls))}
+    costs = {
+        (i, j): cost(hulls[i], hulls[j])
+        for i in range(len(hulls))
+        for j in range(i + 1, len(hulls))
+    }
     alive = list(range(len(hulls)))
     while len(alive) > limit:
-        i, j = min(((a, b) for a, b in costs if a in alive and b in alive),
-                   key=lambda pair: (costs[pair], pair))
+        i, j = min(
+            ((a, b) for a, b in costs if a in alive and b in alive),
+            key=lambda pair: (costs[pair], pair),
+        )
         hulls.append(mf.Manifold.batch_hull([hulls[i], hulls[j]]))
         new = len(hulls) - 1
         alive = [k for k in alive if k not in (i, j)]
@@ -164,9 +177,11 @@ def run_coacd(solid: Mesh, seed: int) -> list:
 
     coarse = _mesh(coarse_solid(solid))
     coacd.set_log_level("error")
-    parts = coacd.run_coacd(coacd.Mesh(np.asarray(coarse.vertices, np.float64),
-                                       np.asarray(coarse.faces, np.int64)),
-                            seed=seed, **COACD_PARAMS)
+    parts = coacd.run_coacd(
+        coacd.Mesh(np.asarray(coarse.vertices, np.float64), np.asarray(coarse.faces, np.int64)),
+        seed=seed,
+        **COACD_PARAMS,
+    )
     COACD_RUNS += 1
     hulls = [_hull(np.asarray(v)) for v, _f in parts if len(v) >= 4]
     hulls = [h for h in hulls if not h.is_empty() and h.volume() > 0]
@@ -215,8 +230,11 @@ def surface_samples(mesh: Mesh) -> np.ndarray:
 
 def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ab = b - a
-    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-30),
-                0.0, 1.0)
+    t = np.clip(
+        np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-30),
+        0.0,
+        1.0,
+    )
     return np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
 
 
@@ -229,13 +247,16 @@ def _point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     for u, v in ((a, b), (b, c), (c, a)):
         inside &= np.einsum("ij,ij->i", np.cross(v - u, p - u), n) >= 0
     plane = np.abs(np.einsum("ij,ij->i", p - a, n)) / np.sqrt(nn)
-    edges = np.minimum(np.minimum(_segment_distance(p, a, b), _segment_distance(p, b, c)),
-                       _segment_distance(p, c, a))
+    edges = np.minimum(
+        np.minimum(_segment_distance(p, a, b), _segment_distance(p, b, c)),
+        _segment_distance(p, c, a),
+    )
     return np.where(inside, plane, edges)
 
 
-def max_distance_to_surface(points: np.ndarray, surface: Mesh, block: int = 256,
-                            nearest: int = 4) -> float:
+def max_distance_to_surface(
+    points: np.ndarray, surface: Mesh, block: int = 256, nearest: int = 4
+) -> float:
     """Largest distance from `points` to the triangle surface `surface` (m), exact.
 
     Per block of points: the distance to each triangle's bounding box is a lower bound; exact
@@ -247,10 +268,12 @@ def max_distance_to_surface(points: np.ndarray, surface: Mesh, block: int = 256,
     k = min(nearest, len(tri))
     worst = 0.0
     for start in range(0, len(points), block):
-        p = points[start:start + block]
+        p = points[start : start + block]
         lower = np.zeros((len(p), len(tri)))
         for axis in range(3):  # squared distance to the box, one axis at a time
-            gap = np.maximum(lo[None, :, axis] - p[:, None, axis], p[:, None, axis] - hi[None, :, axis])
+            gap = np.maximum(
+                lo[None, :, axis] - p[:, None, axis], p[:, None, axis] - hi[None, :, axis]
+            )
             np.maximum(gap, 0, out=gap)
             lower += gap * gap
         np.sqrt(lower, out=lower)
@@ -286,7 +309,9 @@ def quality(solid: Mesh, pieces: list) -> dict:
         "hull_volume_sum_ratio": sum(p.volume() for p in pieces) / volume,
         # booleans of nearly coincident surfaces can round slightly below zero: clamp
         "coverage": 1.0 - min(max((visual - union).volume() / volume, 0.0), 1.0),
-        "visual_to_collision_max_m": max_distance_to_surface(rest, _mesh(union)) if len(rest) else 0.0,
+        "visual_to_collision_max_m": max_distance_to_surface(rest, _mesh(union))
+        if len(rest)
+        else 0.0,
     }
 
 
@@ -301,8 +326,11 @@ def link_collision(link: Link, seed: int) -> tuple[tuple[Mesh, ...], dict]:
     method = method_of(link)
     if method == "primitives":
         shown = [primitive_solid(s).hull() for s in link.collision_primitives]
-        report = {"method": method, **quality(link.solid, shown)} if link.solid and shown else {
-            "method": method, "pieces": len(link.collision_primitives)}
+        report = (
+            {"method": method, **quality(link.solid, shown)}
+            if link.solid and shown
+            else {"method": method, "pieces": len(link.collision_primitives)}
+        )
         return (), report
     if link.solid is None:
         return (), {"method": method, "pieces": 0}

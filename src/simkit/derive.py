@@ -88,7 +88,7 @@ def derive_all(robot: Robot, base_dir: Path, cache: Cache | None = None, jobs: i
     robot = inertia_decision.derive_inertia_decisions(robot)
     robot = dynamics.derive_actuators(robot)
     robot = derive_references(robot)
-    robot = ros2_control.derive_depends(robot)  # spec `ros2_control:` only
+    robot = ros2_control.derive_ros2_control(robot)  # spec `ros2_control:` only
     # last: samples the final collision geometry
     robot = derived_step(robot, cache, "collision_pairs", collision_pairs.derive_collision_pairs)
     # motion data after the servos: its inverse-dynamics check reads the final MJCF

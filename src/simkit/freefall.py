@@ -58,8 +58,9 @@ def load_models(kit) -> dict:
     return models
 
 
-def simulate(model, names: list[str], q0, duration: float, timestep: float,
-             friction: bool) -> np.ndarray:
+def simulate(
+    model, names: list[str], q0, duration: float, timestep: float, friction: bool
+) -> np.ndarray:
     """Joint angles (rad) every SAMPLE_DT after release from rest at q0: RK4 at `timestep`,
     actuators off, frictionloss as in the file or zero. Shape (samples, joints)."""
     import mujoco
@@ -100,8 +101,10 @@ def _frictionless(robot: Robot) -> Robot:
 def _independent(robot: Robot, q0, duration: float) -> dict[str, np.ndarray]:
     """Both runs of the independent integration, checked against the joint limits."""
     times = sample_times(duration)
-    out = {"rigid": rnea.integrate(_frictionless(robot), q0, duration, times),
-           "friction": rnea.integrate(robot, q0, duration, times)}
+    out = {
+        "rigid": rnea.integrate(_frictionless(robot), q0, duration, times),
+        "friction": rnea.integrate(robot, q0, duration, times),
+    }
     for run, traj in out.items():
         for k, joint in enumerate(robot.movable_joints):
             if joint.lower is None or joint.type == "continuous":
@@ -109,9 +112,15 @@ def _independent(robot: Robot, q0, duration: float) -> dict[str, np.ndarray]:
             outside = (traj[:, k] < joint.lower) | (traj[:, k] > joint.upper)
             if outside.any():
                 t = float(times[int(np.argmax(outside))])
-                raise SpecError(robot.spec_file, None, "freefall.pose", (
-                    f"released at '{robot.freefall.pose}', {joint.name} leaves its limits at "
-                    f"t = {t:.2f} s ({run} run); choose a pose that swings inside the limits"))
+                raise SpecError(
+                    robot.spec_file,
+                    None,
+                    "freefall.pose",
+                    (
+                        f"released at '{robot.freefall.pose}', {joint.name} leaves its limits at "
+                        f"t = {t:.2f} s ({run} run); choose a pose that swings inside the limits"
+                    ),
+                )
     return out
 
 
@@ -136,8 +145,10 @@ def mujoco_runs(kit, q0, duration: float) -> tuple[dict, float, dict]:
     runs: dict = {}
     for run in RUNS:
         models = load_models(kit)
-        runs[run] = {side: simulate(models[side], names, q0, duration, timestep,
-                                    friction=run == "friction") for side in ("mjcf", "urdf")}
+        runs[run] = {
+            side: simulate(models[side], names, q0, duration, timestep, friction=run == "friction")
+            for side in ("mjcf", "urdf")
+        }
     own = load_models(kit)["mjcf"]
     own.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
     own.dof_frictionloss[:] = 0.0
@@ -151,10 +162,24 @@ def figures(trajectories: dict) -> dict:
     for run in RUNS:
         sides = trajectories[run]
         out[run] = {
-            f"{a}_vs_{b}": {"rms": rms(sides[a], sides[b]),
-                            "max_abs": float(np.max(np.abs(sides[a] - sides[b])))}
+            f"{a}_vs_{b}": {
+                "rms": rms(sides[a], sides[b]),
+                "max_abs": float(np.max(np.abs(sides[a] - sides[b]))),
+            }
             for a, b in PAIRS
         }
+    return out
+
+
+def _versions(names: tuple[str, ...]) -> dict[str, str | None]:
+    from importlib import metadata
+
+    out: dict[str, str | None] = {}
+    for name in names:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
     return out
 
 
@@ -197,9 +222,11 @@ def derive_freefall(robot: Robot) -> Robot:
         },
         "runs": {
             "rigid": {"friction": "off on every side", **numbers["rigid"]},
-            "friction": {"friction": "the spec's joint friction on every side (MuJoCo "
-                         "frictionloss; Coulomb in the independent integration)",
-                         **numbers["friction"]},
+            "friction": {
+                "friction": "the spec's joint friction on every side (MuJoCo "
+                "frictionloss; Coulomb in the independent integration)",
+                **numbers["friction"],
+            },
         },
         "mjcf_own_integrator": {
             "integrator": own["integrator"],
@@ -207,12 +234,20 @@ def derive_freefall(robot: Robot) -> Robot:
             "rigid_rms_vs_independent": rms(own["rigid"], independent["rigid"]),
             "note": "informational: the MJCF's own integrator at its own timestep",
         },
+        "libraries": _versions(("scipy", "mujoco", "matplotlib")),
         "worst_rms": worst,
         "passed": worst < setup.tolerance_rms,
         "files": {"csv": layout.freefall_csv(), "plot": layout.freefall_plot()},
     }
-    derived = dict(robot.derived, freefall={"t": sample_times(setup.duration), "joints": names,
-                                            "trajectories": trajectories, "figures": numbers,
-                                            "tolerance_rms": setup.tolerance_rms})
+    derived = dict(
+        robot.derived,
+        freefall={
+            "t": sample_times(setup.duration),
+            "joints": names,
+            "trajectories": trajectories,
+            "figures": numbers,
+            "tolerance_rms": setup.tolerance_rms,
+        },
+    )
     validation = dict(robot.derived.get("robot_json", {}).get("validation", {}), freefall=record)
     return with_json(replace(robot, derived=derived), "validation", validation)

@@ -51,12 +51,16 @@ def derive_inertia_decisions(robot: Robot) -> Robot:
             links.append(link)
             continue
         emitted = balanced(decision.reported)
-        if inertia_problem(InertiaSpec(**dict(zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"),
-                                                  emitted, strict=True)))):
+        if inertia_problem(
+            InertiaSpec(
+                **dict(zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), emitted, strict=True))
+            )
+        ):
             raise ValueError(f"balanced inertia of {link.name} is still not physical")
         inertial = Inertial(link.inertial.mass, link.inertial.com, emitted)
-        links.append(replace(link, inertial=inertial,
-                             inertia_decision=replace(decision, emitted=emitted)))
+        links.append(
+            replace(link, inertial=inertial, inertia_decision=replace(decision, emitted=emitted))
+        )
     return replace(robot, links=tuple(links))
 
 

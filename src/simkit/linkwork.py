@@ -47,7 +47,9 @@ def _solid_key(link: Link, base_dir: Path) -> str:
     for shape in link.shapes:
         if shape.kind == "mesh" and shape.file:
             path = base_dir / shape.file
-            inputs.append(path.read_bytes() if path.is_file() else b"missing:" + shape.file.encode())
+            inputs.append(
+                path.read_bytes() if path.is_file() else b"missing:" + shape.file.encode()
+            )
     libraries = ("manifold3d", "trimesh") if inputs else ("manifold3d",)
     params = {"shapes": [asdict(s) for s in link.shapes], "segments": CIRCULAR_SEGMENTS}
     return make_key(SOLID_STEP, SOLID_VERSION, inputs, params, libraries)
@@ -103,9 +105,16 @@ def _description() -> dict:
 def _collision_key(link: Link, seed: int) -> str:
     from simkit import collision
 
-    inputs = [] if link.solid is None else [link.solid.vertices.tobytes(), link.solid.faces.tobytes()]
-    return make_key(COLLISION_STEP, COLLISION_VERSION, inputs, collision.key_params(link, seed),
-                    ("coacd", "manifold3d", "numpy"))
+    inputs = (
+        [] if link.solid is None else [link.solid.vertices.tobytes(), link.solid.faces.tobytes()]
+    )
+    return make_key(
+        COLLISION_STEP,
+        COLLISION_VERSION,
+        inputs,
+        collision.key_params(link, seed),
+        ("coacd", "manifold3d", "numpy"),
+    )
 
 
 def _pack(pieces: tuple[Mesh, ...], report: dict) -> dict[str, np.ndarray]:
@@ -114,7 +123,9 @@ def _pack(pieces: tuple[Mesh, ...], report: dict) -> dict[str, np.ndarray]:
     return {
         "vertices": np.concatenate(verts) if verts else np.zeros((0, 3)),
         "faces": np.concatenate(faces) if faces else np.zeros((0, 3), np.int64),
-        "counts": np.array([[len(v), len(f)] for v, f in zip(verts, faces)], np.int64).reshape(-1, 2),
+        "counts": np.array(
+            [[len(v), len(f)] for v, f in zip(verts, faces, strict=True)], np.int64
+        ).reshape(-1, 2),
         "report": encode_json(report),
     }
 
@@ -122,7 +133,7 @@ def _pack(pieces: tuple[Mesh, ...], report: dict) -> dict[str, np.ndarray]:
 def _unpack(arrays: dict[str, np.ndarray]) -> tuple[tuple[Mesh, ...], dict]:
     pieces, v0, f0 = [], 0, 0
     for nv, nf in arrays["counts"]:
-        pieces.append(Mesh.of(arrays["vertices"][v0:v0 + nv], arrays["faces"][f0:f0 + nf]))
+        pieces.append(Mesh.of(arrays["vertices"][v0 : v0 + nv], arrays["faces"][f0 : f0 + nf]))
         v0, f0 = v0 + int(nv), f0 + int(nf)
     return tuple(pieces), decode_json(arrays["report"])  # type: ignore[return-value]
 
@@ -151,8 +162,14 @@ class _Reporter:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
-            self.bar = Progress("collision", BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                                console=Console(stderr=True), transient=True)
+            self.bar = Progress(
+                "collision",
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                console=Console(stderr=True),
+                transient=True,
+            )
             self.task = self.bar.add_task("collision", total=total)
             self.bar.start()
 
@@ -160,16 +177,19 @@ class _Reporter:
         if self.bar is not None:
             self.bar.advance(self.task)
         elif self.say is not None:
-            self.say(f"collision {link}: {report.get('method')}, {report.get('pieces')} pieces, "
-                     f"{seconds:.1f} s")
+            self.say(
+                f"collision {link}: {report.get('method')}, {report.get('pieces')} pieces, "
+                f"{seconds:.1f} s"
+            )
 
     def close(self) -> None:
         if self.bar is not None:
             self.bar.stop()
 
 
-def derive_collision(robot: Robot, cache: Cache, jobs: int | None = None,
-                     progress: Progress | None = None) -> Robot:
+def derive_collision(
+    robot: Robot, cache: Cache, jobs: int | None = None, progress: Progress | None = None
+) -> Robot:
     """Collision pieces and quality reports for every link. Cache misses that need CoACD run
     in a process pool (when there are two or more and `jobs` > 1); the rest run here."""
     from simkit import collision
@@ -195,10 +215,15 @@ def derive_collision(robot: Robot, cache: Cache, jobs: int | None = None,
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor
 
-            pool = ProcessPoolExecutor(max_workers=min(jobs, len(slow)), initializer=_init_worker,
-                                       mp_context=multiprocessing.get_context("spawn"))
-            futures = {link.name: (pool.submit(_collision_job, link, robot.seed), key)
-                       for link, key in slow}
+            pool = ProcessPoolExecutor(
+                max_workers=min(jobs, len(slow)),
+                initializer=_init_worker,
+                mp_context=multiprocessing.get_context("spawn"),
+            )
+            futures = {
+                link.name: (pool.submit(_collision_job, link, robot.seed), key)
+                for link, key in slow
+            }
             here = fast
         for link, key in here:  # runs here while the pool works on the CoACD links
             pieces, report, _runs, seconds = _collision_job(link, robot.seed)
@@ -213,17 +238,24 @@ def derive_collision(robot: Robot, cache: Cache, jobs: int | None = None,
         if pool is not None:
             pool.shutdown(cancel_futures=True)
         reporter.close()
-    links = tuple(replace(link, collision=results[link.name][0],
-                          collision_report=results[link.name][1]) for link in robot.links)
+    links = tuple(
+        replace(link, collision=results[link.name][0], collision_report=results[link.name][1])
+        for link in robot.links
+    )
     geometry = [{"name": link.name, "collision": link.collision_report} for link in links]
     uses_coacd = any(link.collision_report.get("method") == "coacd" for link in links)
     seeds = {**robot.derived.get("seeds", {}), **({"coacd": robot.seed} if uses_coacd else {})}
-    derived = {**robot.derived, "geometry_links": geometry, "geometry_collision": _description(),
-               "seeds": seeds}
+    derived = {
+        **robot.derived,
+        "geometry_links": geometry,
+        "geometry_collision": _description(),
+        "seeds": seeds,
+    }
     return replace(robot, links=links, derived=derived)
 
 
-def _store(cache: Cache, key: str, results: dict, name: str, pieces: tuple[Mesh, ...],
-           report: dict) -> None:
+def _store(
+    cache: Cache, key: str, results: dict, name: str, pieces: tuple[Mesh, ...], report: dict
+) -> None:
     cache.put(COLLISION_STEP, key, _pack(pieces, report))
     results[name] = (pieces, report)

@@ -89,9 +89,16 @@ class Tree:
                 inertia.append(np.zeros((3, 3)))
         joints = {j.name: j for j in robot.joints}
         return Tree(
-            names=tuple(movable), parent=tuple(parent), kind=tuple(kind), dof=tuple(dof),
-            origin_rot=tuple(rots), origin_pos=tuple(poss), axis=tuple(axes),
-            mass=np.array(mass), com=tuple(com), inertia=tuple(inertia),
+            names=tuple(movable),
+            parent=tuple(parent),
+            kind=tuple(kind),
+            dof=tuple(dof),
+            origin_rot=tuple(rots),
+            origin_pos=tuple(poss),
+            axis=tuple(axes),
+            mass=np.array(mass),
+            com=tuple(com),
+            inertia=tuple(inertia),
             armature=np.array([joints[n].armature for n in movable]),
             damping=np.array([joints[n].damping for n in movable]),
             friction=np.array([joints[n].friction for n in movable]),
@@ -120,7 +127,8 @@ class Tree:
         for i, p in enumerate(self.parent):
             rot, pos = poses[i]
             w_p, al_p, a_p, o_p = (
-                (omega[p], alpha[p], acc[p], poses[p][1]) if p >= 0
+                (omega[p], alpha[p], acc[p], poses[p][1])
+                if p >= 0
                 else (np.zeros(3), np.zeros(3), a_root, np.zeros(3))
             )
             d = pos - o_p
@@ -202,8 +210,9 @@ def integrate(robot: Robot, q0, duration: float, times: np.ndarray) -> np.ndarra
         return np.concatenate([qd, tree.acceleration(q, qd)])
 
     state0 = np.concatenate([np.asarray(q0, float), np.zeros(n)])
-    sol = solve_ivp(rhs, (0.0, duration), state0, method="DOP853", t_eval=times,
-                    rtol=RTOL, atol=ATOL)
+    sol = solve_ivp(
+        rhs, (0.0, duration), state0, method="DOP853", t_eval=times, rtol=RTOL, atol=ATOL
+    )
     if not sol.success:  # pragma: no cover - DOP853 on a smooth ODE
         raise RuntimeError(f"free-fall integration failed: {sol.message}")
     return sol.y[:n].T

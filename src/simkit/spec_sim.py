@@ -110,15 +110,19 @@ def problems(spec, inertia_problem) -> Iterator[Problem]:
         if link.inertia is None:
             yield ("links", i, "inertia_decision"), "an inertia_decision needs the link's inertia"
         elif inertia_problem(link.inertia) is None:
-            yield ("links", i, "inertia_decision"), (
-                "the inertia is physical; remove the inertia_decision"
+            yield (
+                ("links", i, "inertia_decision"),
+                ("the inertia is physical; remove the inertia_decision"),
             )
         elif link.inertia.ixx + link.inertia.iyy + link.inertia.izz <= 0:
             yield ("links", i, "inertia_decision"), "no balanced replacement: the trace is not > 0"
         if decision.action == "exclude_from_dynamics" and not welded_to_root(spec, link.name):
-            yield ("links", i, "inertia_decision", "action"), (
-                f"'{link.name}' moves (it is not welded to the root '{spec.root}' by fixed "
-                "joints), so its inertia cannot be excluded from the dynamics"
+            yield (
+                ("links", i, "inertia_decision", "action"),
+                (
+                    f"'{link.name}' moves (it is not welded to the root '{spec.root}' by fixed "
+                    "joints), so its inertia cannot be excluded from the dynamics"
+                ),
             )
     rc = spec.ros2_control
     if rc is not None:
@@ -126,12 +130,14 @@ def problems(spec, inertia_problem) -> Iterator[Problem]:
             if name not in links:
                 yield ("ros2_control", "gazebo_materials", name), f"unknown link '{name}'"
         if rc.position_pid is not None and "effort" not in rc.command_interfaces:
-            yield ("ros2_control", "position_pid"), (
-                "PID position controllers command effort: add 'effort' to command_interfaces"
+            yield (
+                ("ros2_control", "position_pid"),
+                ("PID position controllers command effort: add 'effort' to command_interfaces"),
             )
         if rc.effort_controllers and "effort" not in rc.command_interfaces:
-            yield ("ros2_control", "effort_controllers"), (
-                "effort controllers need 'effort' in command_interfaces"
+            yield (
+                ("ros2_control", "effort_controllers"),
+                ("effort controllers need 'effort' in command_interfaces"),
             )
         if rc.default_control == "position" and rc.position_pid is None:
             yield ("ros2_control", "default_control"), "default 'position' needs position_pid"

@@ -41,17 +41,33 @@ def check_freefall(kit: Kit) -> list[Finding]:
         return findings
     runs, _, _ = freefall.mujoco_runs(kit, record["q0"], record["duration"])
     for run in freefall.RUNS:
-        sides = {"independent": np.column_stack([columns[f"{run}.independent.{j}"] for j in joints]),
-                 **runs[run]}
+        sides = {
+            "independent": np.column_stack([columns[f"{run}.independent.{j}"] for j in joints]),
+            **runs[run],
+        }
         for side in ("mjcf", "urdf"):
             recorded = np.column_stack([columns[f"{run}.{side}.{j}"] for j in joints])
-            findings.append(compare(f"freefall.{run}.{side}.reproduce",
-                                    f"{side.upper()} free fall ({run}) vs the recorded trajectory",
-                                    recorded, sides[side], REPRODUCE_TOL, "rad"))
+            findings.append(
+                compare(
+                    f"freefall.{run}.{side}.reproduce",
+                    f"{side.upper()} free fall ({run}) vs the recorded trajectory",
+                    recorded,
+                    sides[side],
+                    REPRODUCE_TOL,
+                    "rad",
+                )
+            )
         for a, b in freefall.PAIRS:
             value = freefall.rms(sides[a], sides[b])
-            findings.append(compare(
-                f"freefall.{run}.{a}_vs_{b}",
-                f"joint-angle RMS difference, {a} vs {b}, {record['duration']:g} s free fall "
-                f"from '{record['pose']}' ({run} run)", 0.0, value, tol, "rad"))
+            findings.append(
+                compare(
+                    f"freefall.{run}.{a}_vs_{b}",
+                    f"joint-angle RMS difference, {a} vs {b}, {record['duration']:g} s free fall "
+                    f"from '{record['pose']}' ({run} run)",
+                    0.0,
+                    value,
+                    tol,
+                    "rad",
+                )
+            )
     return findings

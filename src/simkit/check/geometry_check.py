@@ -33,7 +33,9 @@ def check_collision(kit: Kit) -> list[Finding]:
     from simkit.stl import from_stl
 
     most, worst_convex, worst_cover, mismatched = 0, 0.0, 0.0, []
-    report = {g["name"]: g.get("collision") or {} for g in kit.doc.get("geometry", {}).get("links", [])}
+    report = {
+        g["name"]: g.get("collision") or {} for g in kit.doc.get("geometry", {}).get("links", [])
+    }
     for link in kit.doc["links"]:
         paths = link["mesh"]["collision"]
         if not paths:
@@ -43,29 +45,53 @@ def check_collision(kit: Kit) -> list[Finding]:
             mismatched.append(link["name"])
         pieces = [from_stl(kit.path(p).read_bytes()) for p in paths]
         for piece in pieces:
-            worst_convex = max(worst_convex, float(_outside(piece.vertices, piece.vertices,
-                                                            piece.faces).max()))
+            worst_convex = max(
+                worst_convex, float(_outside(piece.vertices, piece.vertices, piece.faces).max())
+            )
         if link["mesh"]["visual"]:
             visual = from_stl(kit.path(link["mesh"]["visual"]).read_bytes()).vertices
             depth = np.min([_outside(visual, p.vertices, p.faces) for p in pieces], axis=0)
             worst_cover = max(worst_cover, float(depth.max()))
     return [
-        require("collision.pieces", most <= MAX_PIECES,
-                f"at most {MAX_PIECES} convex pieces per link (most: {most})"),
-        compare("collision.convex", "largest distance of a piece's vertex outside its own face "
-                "planes", 0.0, worst_convex, CONVEX_TOL, "m"),
-        compare("collision.cover", "largest distance of a visual vertex outside every piece",
-                0.0, worst_cover, COVER_TOL, "m"),
-        require("collision.report", not mismatched, "robot.json geometry pieces match the files"
-                + (f" except {mismatched}" if mismatched else "")),
+        require(
+            "collision.pieces",
+            most <= MAX_PIECES,
+            f"at most {MAX_PIECES} convex pieces per link (most: {most})",
+        ),
+        compare(
+            "collision.convex",
+            "largest distance of a piece's vertex outside its own face planes",
+            0.0,
+            worst_convex,
+            CONVEX_TOL,
+            "m",
+        ),
+        compare(
+            "collision.cover",
+            "largest distance of a visual vertex outside every piece",
+            0.0,
+            worst_cover,
+            COVER_TOL,
+            "m",
+        ),
+        require(
+            "collision.report",
+            not mismatched,
+            "robot.json geometry pieces match the files"
+            + (f" except {mismatched}" if mismatched else ""),
+        ),
     ]
 
 
 def _quat_matrix(q) -> np.ndarray:
     x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def glb_world(doc: dict, q: dict[str, float]) -> dict[str, np.ndarray]:
@@ -75,8 +101,9 @@ def glb_world(doc: dict, q: dict[str, float]) -> dict[str, np.ndarray]:
 
     def walk(index: int, parent: np.ndarray) -> None:
         node = doc["nodes"][index]
-        local = transform(node.get("translation", (0, 0, 0)),
-                          _quat_matrix(node.get("rotation", (0, 0, 0, 1))))
+        local = transform(
+            node.get("translation", (0, 0, 0)), _quat_matrix(node.get("rotation", (0, 0, 0, 1)))
+        )
         joint = node.get("extras", {}).get("joint", {})
         value = q.get(joint.get("name", ""), 0.0)
         if joint.get("type") in ("revolute", "continuous"):
@@ -108,8 +135,13 @@ def check_glb(kit: Kit) -> list[Finding]:
         return [require("glb.file", False, f"{rel}: {exc}")]
     names = {node.get("name") for node in doc["nodes"]}
     missing = [link["name"] for link in kit.doc["links"] if link["name"] not in names]
-    findings = [require("glb.nodes", not missing, "a GLB node per link"
-                        + (f"; missing {missing}" if missing else ""))]
+    findings = [
+        require(
+            "glb.nodes",
+            not missing,
+            "a GLB node per link" + (f"; missing {missing}" if missing else ""),
+        )
+    ]
     tool = kit.doc.get("tool_frame")
     if tool and tool in names and kit.joints:
         joint_names = [j["name"] for j in kit.joints]
@@ -120,8 +152,24 @@ def check_glb(kit: Kit) -> list[Finding]:
             ref = kit.fk(q)
             errors.append(pose[:3, 3] - ref[:3, 3])
             rot_errors.append(pose[:3, :3] - ref[:3, :3])
-        findings.append(compare("glb.fk", f"{tool} from GLB nodes at 10 random configurations vs "
-                                "robot.json FK", np.zeros((len(errors), 3)), errors, GLB_FK_TOL, "m"))
-        findings.append(compare("glb.fk.rotation", f"{tool} rotation, GLB vs robot.json",
-                                np.zeros((len(rot_errors), 3, 3)), rot_errors, GLB_FK_TOL, ""))
+        findings.append(
+            compare(
+                "glb.fk",
+                f"{tool} from GLB nodes at 10 random configurations vs robot.json FK",
+                np.zeros((len(errors), 3)),
+                errors,
+                GLB_FK_TOL,
+                "m",
+            )
+        )
+        findings.append(
+            compare(
+                "glb.fk.rotation",
+                f"{tool} rotation, GLB vs robot.json",
+                np.zeros((len(rot_errors), 3, 3)),
+                rot_errors,
+                GLB_FK_TOL,
+                "",
+            )
+        )
     return findings

@@ -47,8 +47,12 @@ def _place(node: dict, xyz, rpy) -> dict:
 
 def _joint_extras(joint: Joint) -> dict:
     """The joint that places this link node: name, type, axis (node frame), limits, links."""
-    extras: dict = {"name": joint.name, "type": joint.type, "parent": joint.parent,
-                    "child": joint.child}
+    extras: dict = {
+        "name": joint.name,
+        "type": joint.type,
+        "parent": joint.parent,
+        "child": joint.child,
+    }
     if joint.movable:
         extras["axis"] = list(joint.axis)
         for key in ("lower", "upper", "max_velocity", "effort_peak"):
@@ -66,15 +70,21 @@ class _Buffer:
         self.views: list[dict] = []
         self.accessors: list[dict] = []
 
-    def add(self, array: np.ndarray, target: int, component: int, kind: str,
-            bounds: bool = False) -> int:
+    def add(
+        self, array: np.ndarray, target: int, component: int, kind: str, bounds: bool = False
+    ) -> int:
         self.data.extend(b"\0" * (-len(self.data) % 4))
         raw = np.ascontiguousarray(array).tobytes()
-        self.views.append({"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw),
-                           "target": target})
+        self.views.append(
+            {"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw), "target": target}
+        )
         self.data.extend(raw)
-        accessor = {"bufferView": len(self.views) - 1, "componentType": component,
-                    "count": int(array.shape[0] if kind != "SCALAR" else array.size), "type": kind}
+        accessor = {
+            "bufferView": len(self.views) - 1,
+            "componentType": component,
+            "count": int(array.shape[0] if kind != "SCALAR" else array.size),
+            "type": kind,
+        }
         if bounds:
             accessor["min"] = [float(v) for v in array.min(axis=0)]
             accessor["max"] = [float(v) for v in array.max(axis=0)]
@@ -91,8 +101,14 @@ def _materials(robot: Robot) -> tuple[list[dict], dict[str, int]]:
     out = []
     for name in names:
         rgba = list(robot.material_rgba(None if name == DEFAULT_MATERIAL else name))
-        material = {"name": name, "pbrMetallicRoughness": {
-            "baseColorFactor": rgba, "metallicFactor": 0.0, "roughnessFactor": ROUGHNESS}}
+        material = {
+            "name": name,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": rgba,
+                "metallicFactor": 0.0,
+                "roughnessFactor": ROUGHNESS,
+            },
+        }
         if rgba[3] < 1.0:
             material["alphaMode"] = "BLEND"
         out.append(material)
@@ -118,9 +134,15 @@ def document(robot: Robot) -> tuple[dict, bytes]:
     buf = _Buffer()
     materials, material_index = _materials(robot)
     meshes: list[dict] = []
-    nodes: list[dict] = [{"name": f"{robot.name}_y_up", "rotation": list(Y_UP), "children": [1],
-                          "extras": {"note": "turns the kit's Z-up frames into glTF's Y-up"}},
-                         {"name": robot.root, "children": []}]
+    nodes: list[dict] = [
+        {
+            "name": f"{robot.name}_y_up",
+            "rotation": list(Y_UP),
+            "children": [1],
+            "extras": {"note": "turns the kit's Z-up frames into glTF's Y-up"},
+        },
+        {"name": robot.root, "children": []},
+    ]
     index = {robot.root: 1}
 
     def attach(parent: str, node: dict) -> None:
@@ -139,18 +161,31 @@ def document(robot: Robot) -> tuple[dict, bytes]:
             small = len(positions) < 65536
             indices = faces.astype("<u2" if small else "<u4").ravel()
             pos = buf.add(positions, ARRAY_BUFFER, FLOAT, "VEC3", bounds=True)
-            idx = buf.add(indices, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT if small else UNSIGNED_INT,
-                          "SCALAR")
+            idx = buf.add(
+                indices, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT if small else UNSIGNED_INT, "SCALAR"
+            )
             material = link.material if link.material in material_index else DEFAULT_MATERIAL
-            meshes.append({"name": link.name, "primitives": [{
-                "attributes": {"POSITION": pos}, "indices": idx,
-                "material": material_index[material], "mode": 4}]})
+            meshes.append(
+                {
+                    "name": link.name,
+                    "primitives": [
+                        {
+                            "attributes": {"POSITION": pos},
+                            "indices": idx,
+                            "material": material_index[material],
+                            "mode": 4,
+                        }
+                    ],
+                }
+            )
             node["mesh"] = len(meshes) - 1
         node["extras"] = {"joint": _joint_extras(joint)}
         attach(joint.parent, node)
     for frame in robot.frames:
-        attach(frame.parent, _place({"name": frame.name, "extras": {"frame": frame.name}},
-                                    frame.xyz, frame.rpy))
+        attach(
+            frame.parent,
+            _place({"name": frame.name, "extras": {"frame": frame.name}}, frame.xyz, frame.rpy),
+        )
     for node in nodes:
         if node.get("children") == []:
             del node["children"]
@@ -176,9 +211,13 @@ def to_glb(doc: dict, binary: bytes) -> bytes:
     text += b" " * (-len(text) % 4)
     binary += b"\0" * (-len(binary) % 4)
     total = 12 + 8 + len(text) + 8 + len(binary)
-    return (struct.pack("<4sII", b"glTF", 2, total)
-            + struct.pack("<I4s", len(text), b"JSON") + text
-            + struct.pack("<I4s", len(binary), b"BIN\0") + binary)
+    return (
+        struct.pack("<4sII", b"glTF", 2, total)
+        + struct.pack("<I4s", len(text), b"JSON")
+        + text
+        + struct.pack("<I4s", len(binary), b"BIN\0")
+        + binary
+    )
 
 
 def read_glb(data: bytes) -> tuple[dict, bytes]:
@@ -189,12 +228,12 @@ def read_glb(data: bytes) -> tuple[dict, bytes]:
     length, kind = struct.unpack_from("<I4s", data, 12)
     if kind != b"JSON":
         raise ValueError("first GLB chunk is not JSON")
-    doc = json.loads(data[20:20 + length])
+    doc = json.loads(data[20 : 20 + length])
     offset = 20 + length
     binary = b""
     if offset < len(data):
         blen, bkind = struct.unpack_from("<I4s", data, offset)
-        binary = data[offset + 8:offset + 8 + blen] if bkind == b"BIN\0" else b""
+        binary = data[offset + 8 : offset + 8 + blen] if bkind == b"BIN\0" else b""
     return doc, binary
 
 

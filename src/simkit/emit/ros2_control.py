@@ -59,8 +59,9 @@ def urdf_elements(robot: Robot) -> list[ET.Element]:
     if rc is None:
         return []
     out: list[ET.Element] = []
-    for link, material in sorted(rc.gazebo_materials.items(),
-                                 key=lambda kv: [lk.name for lk in robot.links].index(kv[0])):
+    for link, material in sorted(
+        rc.gazebo_materials.items(), key=lambda kv: [lk.name for lk in robot.links].index(kv[0])
+    ):
         gazebo = ET.Element("gazebo", reference=link)
         sub(gazebo, "material").text = material
         out.append(gazebo)
@@ -129,8 +130,13 @@ def exec_depends(robot: Robot) -> list[str]:
     rc = robot.ros2_control
     if rc is None:
         return []
-    out = {"controller_manager", "gz_ros2_control", "joint_state_broadcaster", "ros_gz_bridge",
-           "ros_gz_sim"}
+    out = {
+        "controller_manager",
+        "gz_ros2_control",
+        "joint_state_broadcaster",
+        "ros_gz_bridge",
+        "ros_gz_sim",
+    }
     if rc.position_pid is not None:
         out.add("pid_controller")
     if rc.effort_controllers:
@@ -138,13 +144,39 @@ def exec_depends(robot: Robot) -> list[str]:
     return sorted(out)
 
 
-def derive_depends(robot: Robot) -> Robot:
-    """Derive step: tell the ROS 2 package emitter (emit/ros2.py) what else to depend on."""
-    extra = exec_depends(robot)
-    if not extra:
+def derive_ros2_control(robot: Robot) -> Robot:
+    """Derive step: the extra ROS 2 packages the package emitter (emit/ros2.py) must depend
+    on, and robot.json's `ros2_control` entry (files, controllers, gains, estimates)."""
+    from simkit.derive import with_json  # derive imports this module
+
+    rc = robot.ros2_control
+    if rc is None:
         return robot
-    merged = sorted(set(robot.derived.get("ros2_exec_depends", ())) | set(extra))
-    return replace(robot, derived={**robot.derived, "ros2_exec_depends": merged})
+    merged = sorted(set(robot.derived.get("ros2_exec_depends", ())) | set(exec_depends(robot)))
+    robot = replace(robot, derived={**robot.derived, "ros2_exec_depends": merged})
+    pid = rc.position_pid
+    return with_json(
+        robot,
+        "ros2_control",
+        {
+            "files": {
+                "controllers": layout.CONTROLLERS_YAML,
+                "gazebo_launch": layout.GAZEBO_LAUNCH,
+            },
+            "hardware_plugin": rc.hardware_plugin,
+            "command_interfaces": list(rc.command_interfaces),
+            "state_interfaces": list(rc.state_interfaces),
+            "update_rate": rc.update_rate,
+            "controllers": controllers(robot),
+            "position_pid": None if pid is None else pid.model_dump(),
+            "transmissions": {
+                j.name: j.drive.gear_ratio if j.drive else 1.0 for j in joints(robot)
+            },
+            "gazebo_materials": dict(rc.gazebo_materials),
+            "default_control": rc.default_control,
+            "estimated": list(rc.estimated),
+        },
+    )
 
 
 def _double(value: float) -> str:
@@ -172,13 +204,21 @@ def _context(robot: Robot) -> dict:
         "update_rate": str(rc.update_rate),
         "broadcaster": JOINT_STATE_BROADCASTER,
         "joints": [
-            {"name": j.name, "position": f"{j.name}_position_controller",
-             "effort": f"{j.name}_effort_controller"}
+            {
+                "name": j.name,
+                "position": f"{j.name}_position_controller",
+                "effort": f"{j.name}_effort_controller",
+            }
             for j in joints(robot)
         ],
-        "pid": None if pid is None else {
-            "p": _double(pid.p), "i": _double(pid.i), "d": _double(pid.d),
-            "i_clamp_max": _double(pid.i_clamp), "i_clamp_min": _double(-pid.i_clamp),
+        "pid": None
+        if pid is None
+        else {
+            "p": _double(pid.p),
+            "i": _double(pid.i),
+            "d": _double(pid.d),
+            "i_clamp_max": _double(pid.i_clamp),
+            "i_clamp_min": _double(-pid.i_clamp),
             "antiwindup": "true" if pid.antiwindup else "false",
         },
         "effort_controllers": rc.effort_controllers,

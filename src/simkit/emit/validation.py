@@ -23,10 +23,12 @@ PLOTTED_RUN = "friction"  # the spec's model as written, friction included
 
 def csv_text(data: dict) -> str:
     """Header `t,<run>.<side>.<joint>,...`, one row per sample (s, rad)."""
-    columns = [(run, side, k, joint)
-               for run, sides in data["trajectories"].items()
-               for side in sides
-               for k, joint in enumerate(data["joints"])]
+    columns = [
+        (run, side, k, joint)
+        for run, sides in data["trajectories"].items()
+        for side in sides
+        for k, joint in enumerate(data["joints"])
+    ]
     lines = ["t," + ",".join(f"{run}.{side}.{joint}" for run, side, _, joint in columns)]
     for i, t in enumerate(data["t"]):
         values = [num(data["trajectories"][run][side][i, k]) for run, side, k, _ in columns]
@@ -54,8 +56,11 @@ def plot_png(robot: Robot, data: dict) -> bytes:
     lines = [
         f"{robot.title}: free fall from rest, {num(data['t'][-1], 3)} s ({PLOTTED_RUN} run shown)",
         "joint-angle RMS difference (rad), MJCF vs indep. / URDF vs indep. / MJCF vs URDF:",
-        "; ".join(f"{run} " + " / ".join(num(figs[run][pair]["rms"], 2) for pair in figs[run])
-                  for run in figs) + f"; bound {num(data['tolerance_rms'], 3)}",
+        "; ".join(
+            f"{run} " + " / ".join(num(figs[run][pair]["rms"], 2) for pair in figs[run])
+            for run in figs
+        )
+        + f"; bound {num(data['tolerance_rms'], 3)}",
     ]
     fig.suptitle("\n".join(lines), fontsize=9)
     fig.tight_layout()
