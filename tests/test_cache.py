@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -118,3 +121,12 @@ def test_warm_derive_hits_every_step_and_emits_the_same_bytes(tmp_path):
     assert warm_cache.stats.hits["link_solid"] == 7 and warm_cache.stats.hits["collision"] == 7
     assert any(step.startswith("derived_") for step in warm_cache.stats.hits)
     assert warm == cold
+    # a warm derive and emit import neither CoACD nor trimesh (issue 3: lazy imports)
+    code = (
+        "import sys; from simkit.build import model_from_spec; from simkit.cache import Cache; "
+        "from simkit.emit import emit_all; "
+        f"emit_all(model_from_spec('rosie_1000', cache=Cache.at({str(tmp_path)!r}))); "
+        "print(sorted(m for m in ('coacd', 'trimesh') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"

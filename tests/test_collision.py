@@ -97,6 +97,20 @@ def test_convex_needs_a_convex_union():
         collision.method_of(replace(hub, collision_method="convex"))
 
 
+def test_convex_on_a_subtracted_solid_is_a_spec_error(tmp_path):
+    from simkit.validate import load_spec
+
+    text = (
+        Path(MIX).read_text().replace("  - name: hub\n", "  - name: hub\n    collision: convex\n")
+    )
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(SpecError) as err:
+        load_spec(path, display="bad.yaml")
+    assert err.value.line is not None and "collision" in err.value.field
+    assert "convex primitives" in err.value.message
+
+
 def _pieces(robot) -> dict[str, list[bytes]]:
     return {
         link.name: [p.vertices.tobytes() + p.faces.tobytes() for p in link.collision]

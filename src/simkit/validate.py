@@ -74,6 +74,11 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield ("links", i, "com"), "a link that gives its inertia must give its com too"
         if not link.solid and link.collision != "primitives":
             yield ("links", i, "solid"), "a link needs a solid (its visual geometry)"
+        if link.collision == "convex" and any(p.subtract or p.shape == "mesh" for p in link.solid):
+            yield ("links", i, "collision"), (
+                "'convex' needs a union of convex primitives (no mesh, no subtract); "
+                "use 'auto' or 'coacd'"
+            )
         allowed = set(type(link).model_fields) - {"name", "estimated", "note"}
         for k, field in enumerate(link.estimated):
             if field not in allowed:
