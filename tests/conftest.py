@@ -44,3 +44,11 @@ def rosie_1000_published(tmp_path_factory) -> tuple[Path, dict]:
 
     out = tmp_path_factory.mktemp("published") / "sim"
     return out, publish(out, ["rosie_1000"], cache=Cache.disabled())
+
+
+def pytest_addoption(parser):
+    parser.addoption(
+        "--update-golden",
+        action="store_true",
+        help="rewrite tests/golden/ from the current emitters instead of comparing",
+    )

@@ -19,8 +19,11 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def _digest_tree(root: Path) -> dict[str, str]:
-    return {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(root.rglob("*")) if p.is_file()}
+    return {
+        p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(root.rglob("*"))
+        if p.is_file()
+    }
 
 
 def test_failed_build_keeps_previous_kit(rosie_1000, tmp_path):
@@ -31,13 +34,18 @@ def test_failed_build_keeps_previous_kit(rosie_1000, tmp_path):
     before = _digest_tree(out)
     # a spec that validates but whose published mass disagrees with its links: the check fails
     spec = tmp_path / "rosie_1000.yaml"
-    spec.write_text((REPO / "robots/rosie_1000.yaml").read_text().replace(
-        "mass: 38.6                  # kg", "mass: 40.0                  # kg"))
-    with pytest.raises(CheckFailed, match="published.mass"):
+    spec.write_text(
+        (REPO / "robots/rosie_1000.yaml")
+        .read_text()
+        .replace("mass: 38.6                  # kg", "mass: 40.0                  # kg")
+    )
+    with pytest.raises(CheckFailed, match=r"published\.mass"):
         build(str(spec), out)
     assert _digest_tree(out) == before
-    assert sorted(p.name for p in out.iterdir()) == [rosie_1000.zip_path.name,
-                                                     rosie_1000.kit_dir.name]
+    assert sorted(p.name for p in out.iterdir()) == [
+        rosie_1000.zip_path.name,
+        rosie_1000.kit_dir.name,
+    ]
 
 
 def test_check_passes_on_built_kit_and_fails_on_tampered_copy(rosie_1000, tmp_path):
@@ -48,8 +56,12 @@ def test_check_passes_on_built_kit_and_fails_on_tampered_copy(rosie_1000, tmp_pa
     mjcf.write_text(mjcf.read_text().replace('mass="10.4"', 'mass="11.4"', 1))
     failed = {f.check for f in run_checks(copy) if not f.ok}
     assert "mass.mjcf" in failed
-    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "check", str(copy)],
-                          capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-m", "simkit.cli", "check", str(copy)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert proc.returncode == 3
     assert "FAIL mass.mjcf" in proc.stdout and "expected" in proc.stdout
 
@@ -58,8 +70,14 @@ def test_kit_layout_and_zip(rosie_1000):
     kit = rosie_1000.kit_dir
     assert kit.name == "rosie_1000_description"
     assert rosie_1000.zip_path.name == "rosie-1000-sim-kit.zip"
-    for rel in ("README.md", "LICENSE.txt", "robot.json", "urdf/rosie_1000.urdf",
-                "mjcf/rosie_1000.xml", "meshes/visual/link_3.stl"):
+    for rel in (
+        "README.md",
+        "LICENSE.txt",
+        "robot.json",
+        "urdf/rosie_1000.urdf",
+        "mjcf/rosie_1000.xml",
+        "meshes/visual/link_3.stl",
+    ):
         assert (kit / rel).is_file(), rel
     import zipfile
 
@@ -68,14 +86,17 @@ def test_kit_layout_and_zip(rosie_1000):
         assert names == sorted(names)
         assert all(n.startswith("rosie_1000_description/") for n in names)
         assert all(i.date_time == (1980, 1, 1, 0, 0, 0) for i in archive.infolist())
-        assert archive.read("rosie_1000_description/robot.json") == (kit / "robot.json").read_bytes()
+        assert (
+            archive.read("rosie_1000_description/robot.json") == (kit / "robot.json").read_bytes()
+        )
     doc = json.loads((kit / "robot.json").read_text())
     assert "/" not in doc["provenance"]["spec"].split("robots/")[0]  # no absolute paths
 
 
 def test_cli_list_and_version():
-    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "list"], capture_output=True,
-                          text=True, timeout=60)
+    proc = subprocess.run(
+        [sys.executable, "-m", "simkit.cli", "list"], capture_output=True, text=True, timeout=60
+    )
     assert proc.returncode == 0
     names = proc.stdout.split()
     assert {"rosie_600", "rosie_1000", "rosie_1400"} <= set(names)
@@ -83,7 +104,30 @@ def test_cli_list_and_version():
 
 
 def test_check_on_missing_folder_is_one_line(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "check", str(tmp_path / "nope")],
-                          capture_output=True, text=True, timeout=60)
+    proc = subprocess.run(
+        [sys.executable, "-m", "simkit.cli", "check", str(tmp_path / "nope")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert proc.returncode != 0
     assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+
+
+def test_warm_rebuild_reuses_check_findings_of_identical_kit(tmp_path):
+    from simkit.cache import Cache
+
+    spec = REPO / "tests/specs/planar_2r.yaml"
+    cold = Cache.at(tmp_path / "cache")
+    first = build(str(spec), tmp_path / "a", cache=cold)
+    assert cold.stats.misses.get("checks") == 1 and not cold.stats.hits.get("checks")
+    warm = Cache.at(tmp_path / "cache")
+    second = build(str(spec), tmp_path / "b", cache=warm)
+    assert warm.stats.hits.get("checks") == 1
+    assert second.findings == first.findings and all(f.ok for f in second.findings)
+    # a different kit (one changed byte in the spec's title) is checked afresh
+    changed = tmp_path / "planar_2r.yaml"
+    changed.write_text(spec.read_text().replace("title: Planar 2R", "title: Planar 2R arm"))
+    third = Cache.at(tmp_path / "cache")
+    build(str(changed), tmp_path / "c", cache=third)
+    assert third.stats.misses.get("checks") == 1

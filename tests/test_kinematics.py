@@ -34,7 +34,7 @@ def test_axis_angle_and_quaternion(x, y, z, q):
     rot = axis_angle(axis, q)
     np.testing.assert_allclose(rot @ axis, axis, atol=1e-12)
     assert abs(np.linalg.det(rot) - 1) < 1e-12
-    w, *v = quat_wxyz(rot)
+    w, *_v = quat_wxyz(rot)
     assert abs(w - abs(np.cos(q / 2))) < 1e-9
 
 
@@ -48,8 +48,10 @@ def test_fk_matches_mujoco_mass_matrix_diagonal(q):
     from simkit.emit import mjcf
 
     xml = mjcf.emit(ROSIE)["mjcf/rosie_1000.xml"].decode()
-    xml = xml.replace('<compiler angle="radian" meshdir="../meshes" autolimits="true" />',
-                      '<compiler angle="radian" autolimits="true" />')
+    xml = xml.replace(
+        '<compiler angle="radian" meshdir="../meshes" autolimits="true" />',
+        '<compiler angle="radian" autolimits="true" />',
+    )
     import re
 
     xml = re.sub(r"<mesh [^>]*/>", "", xml)
@@ -64,8 +66,11 @@ def test_fk_matches_mujoco_mass_matrix_diagonal(q):
         assert abs(axis_inertia(ROSIE, joint.name, q) - expected) < 1e-9 * max(1, expected)
     poses = forward(ROSIE, q)
     base = poses["base_link"]
-    np.testing.assert_allclose((np.linalg.inv(base) @ poses["tool0"])[:3, 3],
-                               (data.site("tool0").xpos - data.body("base_link").xpos), atol=1e-12)
+    np.testing.assert_allclose(
+        (np.linalg.inv(base) @ poses["tool0"])[:3, 3],
+        (data.site("tool0").xpos - data.body("base_link").xpos),
+        atol=1e-12,
+    )
 
 
 @given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e9, max_value=1e9))

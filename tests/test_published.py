@@ -15,9 +15,15 @@ from simkit.dynamics import gravity_torques
 # Kit page (000_5f76ade803e16979.txt), table "Robot | Wrist centre | Published reach | tool0 at
 # home | Mass" and "Frames and conventions".
 PUBLISHED = {
-    "rosie_600": dict(wrist=0.6000, reach=(0.600, 0.677), tool0=(0.330, 0, 0.423), height=0.175, mass=29.3),
-    "rosie_1000": dict(wrist=1.0000, reach=(1.000, 1.077), tool0=(0.530, 0, 0.623), height=0.175, mass=38.6),
-    "rosie_1400": dict(wrist=1.4337, reach=(1.400, 1.499), tool0=(0.834, 0, 0.756), height=0.0294, mass=77.0),
+    "rosie_600": dict(
+        wrist=0.6000, reach=(0.600, 0.677), tool0=(0.330, 0, 0.423), height=0.175, mass=29.3
+    ),
+    "rosie_1000": dict(
+        wrist=1.0000, reach=(1.000, 1.077), tool0=(0.530, 0, 0.623), height=0.175, mass=38.6
+    ),
+    "rosie_1400": dict(
+        wrist=1.4337, reach=(1.400, 1.499), tool0=(0.834, 0, 0.756), height=0.0294, mass=77.0
+    ),
 }
 MM = 1e-4  # 0.1 mm
 KG = 0.01
@@ -35,7 +41,9 @@ def _mj_tool0(model, q):
     mujoco.mj_forward(model, data)
     base = data.body("base_link")
     rot = base.xmat.reshape(3, 3)
-    return rot.T @ (data.site("tool0").xpos - base.xpos), rot.T @ data.site("tool0").xmat.reshape(3, 3)
+    return rot.T @ (data.site("tool0").xpos - base.xpos), rot.T @ data.site("tool0").xmat.reshape(
+        3, 3
+    )
 
 
 def test_robot_json_numbers(kit):
@@ -96,8 +104,9 @@ def test_peak_torque_holds_rated_payload_when_stretched(name):
     robot = model_from_spec(name)
     payload = robot.published["payload"]
     tool = np.eye(3) * 1e-6
-    torques = gravity_torques(robot, robot.pose("stretched"),
-                              extra=[("link_6", payload, (0.0, 0.0, -0.05), tool)])
+    torques = gravity_torques(
+        robot, robot.pose("stretched"), extra=[("link_6", payload, (0.0, 0.0, -0.05), tool)]
+    )
     for joint in robot.movable_joints:
         assert abs(torques[joint.name]) < joint.effort_peak, joint.name
         assert joint.effort_peak <= joint.drive_peak_torque_at_joint + 1e-9, joint.name

@@ -65,8 +65,13 @@ print(fk(robot["home"])[:3, 3])
 
 
 def _run(kit_dir, code: str) -> list[str]:
-    proc = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=kit_dir,
-                          capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        cwd=kit_dir,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert proc.returncode == 0, proc.stderr
     return proc.stdout.strip().splitlines()
 

@@ -34,26 +34,68 @@ def _line_of(path: Path, needle: str) -> int:
 
 
 CASES = [
-    ("negative mass", "    mass: 7.2\n", "    mass: -7.2\n", "mass: -7.2", "links[1].mass", "mass must be > 0"),
-    ("lower > upper", "    lower_deg: -135\n", "    lower_deg: 170\n", "lower_deg: 170", "joints[2].lower_deg",
-     "greater than upper"),
-    ("unknown parent", "    parent: link_4\n", "    parent: link_44\n", "parent: link_44",
-     "joints[5].parent", "unknown parent link 'link_44'"),
-    ("inertia not positive definite", "    mass: 2.9\n",
-     "    mass: 2.9\n    com: [0, 0, 0]\n    inertia: {ixx: 0.01, iyy: 0.01, izz: -0.01}\n",
-     "inertia: {ixx", "links[5].inertia", "not positive definite"),
-    ("inertia breaks triangle inequality", "    mass: 2.9\n",
-     "    mass: 2.9\n    com: [0, 0, 0]\n    inertia: {ixx: 0.001, iyy: 0.001, izz: 0.01}\n",
-     "inertia: {ixx", "links[5].inertia", "triangle inequality"),
-    ("unknown field", "    material: flange_steel\n", "    material: flange_steel\n    colour: red\n",
-     "colour: red", "links[6].colour", "unknown field"),
-    ("malformed YAML", "  - name: joint_3\n", "  - name: joint_3\n   bad: [1, 2\n", "bad: [1, 2",
-     "<yaml>", "malformed YAML"),
+    (
+        "negative mass",
+        "    mass: 7.2\n",
+        "    mass: -7.2\n",
+        "mass: -7.2",
+        "links[1].mass",
+        "mass must be > 0",
+    ),
+    (
+        "lower > upper",
+        "    lower_deg: -135\n",
+        "    lower_deg: 170\n",
+        "lower_deg: 170",
+        "joints[2].lower_deg",
+        "greater than upper",
+    ),
+    (
+        "unknown parent",
+        "    parent: link_4\n",
+        "    parent: link_44\n",
+        "parent: link_44",
+        "joints[5].parent",
+        "unknown parent link 'link_44'",
+    ),
+    (
+        "inertia not positive definite",
+        "    mass: 2.9\n",
+        "    mass: 2.9\n    com: [0, 0, 0]\n    inertia: {ixx: 0.01, iyy: 0.01, izz: -0.01}\n",
+        "inertia: {ixx",
+        "links[5].inertia",
+        "not positive definite",
+    ),
+    (
+        "inertia breaks triangle inequality",
+        "    mass: 2.9\n",
+        "    mass: 2.9\n    com: [0, 0, 0]\n    inertia: {ixx: 0.001, iyy: 0.001, izz: 0.01}\n",
+        "inertia: {ixx",
+        "links[5].inertia",
+        "triangle inequality",
+    ),
+    (
+        "unknown field",
+        "    material: flange_steel\n",
+        "    material: flange_steel\n    colour: red\n",
+        "colour: red",
+        "links[6].colour",
+        "unknown field",
+    ),
+    (
+        "malformed YAML",
+        "  - name: joint_3\n",
+        "  - name: joint_3\n   bad: [1, 2\n",
+        "bad: [1, 2",
+        "<yaml>",
+        "malformed YAML",
+    ),
 ]
 
 
-@pytest.mark.parametrize(("label", "old", "new", "needle", "field", "message"), CASES,
-                         ids=[c[0] for c in CASES])
+@pytest.mark.parametrize(
+    ("label", "old", "new", "needle", "field", "message"), CASES, ids=[c[0] for c in CASES]
+)
 def test_library_reports_file_line_field(tmp_path, label, old, new, needle, field, message):
     path = _variant(tmp_path, old, new)
     with pytest.raises(SpecError) as info:
@@ -67,14 +109,26 @@ def test_library_reports_file_line_field(tmp_path, label, old, new, needle, fiel
     assert err.line is not None and expected_line <= err.line <= expected_line + 1
 
 
-@pytest.mark.parametrize("label", ["negative mass", "lower > upper", "unknown parent",
-                                   "inertia not positive definite", "malformed YAML"])
+@pytest.mark.parametrize(
+    "label",
+    [
+        "negative mass",
+        "lower > upper",
+        "unknown parent",
+        "inertia not positive definite",
+        "malformed YAML",
+    ],
+)
 def test_cli_one_line_no_traceback_no_output(tmp_path, label):
     case = next(c for c in CASES if c[0] == label)
     path = _variant(tmp_path, case[1], case[2])
     out = tmp_path / "out"
-    proc = subprocess.run([sys.executable, "-m", "simkit.cli", "build", str(path), "--out", str(out)],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "simkit.cli", "build", str(path), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode != 0
     lines = [line for line in proc.stderr.splitlines() if line.strip() and not line.startswith("[")]
     assert len(lines) == 1, proc.stderr
@@ -85,8 +139,12 @@ def test_cli_one_line_no_traceback_no_output(tmp_path, label):
 
 def test_cli_unknown_robot_and_missing_file(tmp_path):
     for target in ("no_such_robot", str(tmp_path / "missing.yaml")):
-        proc = subprocess.run([sys.executable, "-m", "simkit.cli", "build", target, "--out",
-                               str(tmp_path)], capture_output=True, text=True, timeout=60)
+        proc = subprocess.run(
+            [sys.executable, "-m", "simkit.cli", "build", target, "--out", str(tmp_path)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         assert proc.returncode != 0
         assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
         assert "Traceback" not in proc.stderr

@@ -16,7 +16,7 @@ from pathlib import Path
 from simkit import layout
 from simkit.archive import zip_bytes
 from simkit.cache import Cache
-from simkit.check import run_checks
+from simkit.check import run_checks_cached
 from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, usd
@@ -54,8 +54,12 @@ def find_spec(target: str) -> tuple[Path, str]:
     return path, f"robots/{path.name}"
 
 
-def model_from_spec(target: str, progress: Progress | None = None, cache: Cache | None = None,
-                    jobs: int | None = None) -> Robot:
+def model_from_spec(
+    target: str,
+    progress: Progress | None = None,
+    cache: Cache | None = None,
+    jobs: int | None = None,
+) -> Robot:
     """Load, validate, resolve and derive: the frozen model every emitter reads. `cache`:
     see `derive.derive_all` (None: the user cache folder); `jobs`: worker processes."""
     path, shown = find_spec(target)
@@ -87,12 +91,19 @@ def _swap_in(staged: Path, final: Path) -> None:
         shutil.rmtree(old) if old.is_dir() else old.unlink()
 
 
-def build(target: str, out_dir: Path, check: bool = True, progress: Progress | None = None,
-          cache: Cache | None = None, jobs: int | None = None,
-          usd_format: str = "usda") -> BuildResult:
+def build(
+    target: str,
+    out_dir: Path,
+    check: bool = True,
+    progress: Progress | None = None,
+    cache: Cache | None = None,
+    jobs: int | None = None,
+    usd_format: str = "usda",
+) -> BuildResult:
     """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`;
     `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`."""
     say = progress or (lambda _msg: None)
+    cache = Cache.at() if cache is None else cache
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
     files = emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)})
@@ -107,7 +118,7 @@ def build(target: str, out_dir: Path, check: bool = True, progress: Progress | N
         findings: list[Finding] = []
         if check:
             say("check")
-            findings = run_checks(staged_kit)
+            findings = run_checks_cached(staged_kit, files, cache)
             failed = [f for f in findings if not f.ok]
             if failed:
                 lines = "; ".join(f.line() for f in failed[:3])
@@ -117,5 +128,6 @@ def build(target: str, out_dir: Path, check: bool = True, progress: Progress | N
         _swap_in(staged_zip, out_dir / layout.zip_name(robot.name))
     finally:
         shutil.rmtree(staging, ignore_errors=True)
-    return BuildResult(robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name),
-                       files, findings)
+    return BuildResult(
+        robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
+    )

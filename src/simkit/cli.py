@@ -28,19 +28,47 @@ def main() -> None:
 
 @main.command()
 @click.argument("targets", nargs=-1, required=True)
-@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
-              default=Path("build"), show_default=True, help="Folder for kits and zips.")
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("build"),
+    show_default=True,
+    help="Folder for kits and zips.",
+)
 @click.option("--no-check", is_flag=True, help="Skip the check stage (not recommended).")
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
-@click.option("-j", "--jobs", type=click.IntRange(min=1), default=None,
-              help="Worker processes for slow per-link steps (CoACD). [default: all cores]")
-@click.option("--cache-dir", type=click.Path(file_okay=False, path_type=Path), default=None,
-              help="Cache folder. [default: $SIMKIT_CACHE_DIR, else the user cache folder]")
+@click.option(
+    "-j",
+    "--jobs",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Worker processes for slow per-link steps (CoACD). [default: all cores]",
+)
+@click.option(
+    "--cache-dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Cache folder. [default: $SIMKIT_CACHE_DIR, else the user cache folder]",
+)
 @click.option("--no-cache", is_flag=True, help="Compute every step; read and write no cache.")
-@click.option("--usd-format", type=click.Choice(["usda", "usdc"]), default="usda",
-              show_default=True, help="USD as text (diffable) or binary crate.")
-def build(targets: tuple[str, ...], out_dir: Path, no_check: bool, quiet: bool,
-          jobs: int | None, cache_dir: Path | None, no_cache: bool, usd_format: str) -> None:
+@click.option(
+    "--usd-format",
+    type=click.Choice(["usda", "usdc"]),
+    default="usda",
+    show_default=True,
+    help="USD as text (diffable) or binary crate.",
+)
+def build(
+    targets: tuple[str, ...],
+    out_dir: Path,
+    no_check: bool,
+    quiet: bool,
+    jobs: int | None,
+    cache_dir: Path | None,
+    no_cache: bool,
+    usd_format: str,
+) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
     from simkit.build import build as run_build
     from simkit.cache import Cache
@@ -48,19 +76,29 @@ def build(targets: tuple[str, ...], out_dir: Path, no_check: bool, quiet: bool,
     cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
 
     for target in targets:
+
         def progress(msg: str, _t: str = target) -> None:
             if not quiet:
                 err.print(f"[{_t}] {msg}", markup=False)
 
         try:
-            result = run_build(target, out_dir, check=not no_check,
-                               progress=None if quiet else progress, cache=cache, jobs=jobs,
-                               usd_format=usd_format)
+            result = run_build(
+                target,
+                out_dir,
+                check=not no_check,
+                progress=None if quiet else progress,
+                cache=cache,
+                jobs=jobs,
+                usd_format=usd_format,
+            )
         except SimkitError as exc:
             _fail(exc)
         passed = sum(f.ok for f in result.findings)
-        out.print(f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-                  f"{result.zip_path}; {passed}/{len(result.findings)} checks passed", markup=False)
+        out.print(
+            f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
+            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed",
+            markup=False,
+        )
 
 
 @main.command()
@@ -113,9 +151,14 @@ def diff(old: Path, new: Path, as_json: bool) -> None:
 
 @main.command()
 @click.argument("robots", nargs=-1)
-@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
-              default=Path("build/assets/sim"), show_default=True,
-              help="The site's /assets/sim/ folder (replaced as a whole).")
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("build/assets/sim"),
+    show_default=True,
+    help="The site's /assets/sim/ folder (replaced as a whole).",
+)
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
 def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
     """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and

@@ -38,7 +38,9 @@ def derive_solids(robot: Robot, base_dir: Path, cache: Cache | None = None) -> R
 def derive_mass(robot: Robot) -> Robot:
     """CoM and inertia from the solid scaled to the link mass, unless the spec gives them."""
     links = tuple(
-        link if link.inertial is not None else replace(link, inertial=massprops.from_solid(link.solid, link.mass))
+        link
+        if link.inertial is not None
+        else replace(link, inertial=massprops.from_solid(link.solid, link.mass))
         for link in robot.links
     )
     return replace(robot, links=links)
@@ -77,8 +79,13 @@ def derive_references(robot: Robot) -> Robot:
     return replace(robot, derived=derived)
 
 
-def derive_all(robot: Robot, base_dir: Path, cache: Cache | None = None, jobs: int | None = None,
-               progress: linkwork.Progress | None = None) -> Robot:
+def derive_all(
+    robot: Robot,
+    base_dir: Path,
+    cache: Cache | None = None,
+    jobs: int | None = None,
+    progress: linkwork.Progress | None = None,
+) -> Robot:
     """All derive steps in order. `cache` defaults to the user cache folder (`cache.py`);
     `jobs` is the process count for slow per-link steps (default: the cores)."""
     cache = Cache.at() if cache is None else cache

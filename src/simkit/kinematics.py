@@ -116,7 +116,9 @@ def forward(robot: Robot, q=None) -> dict[str, np.ndarray]:
     poses: dict[str, np.ndarray] = {robot.root: np.eye(4)}
     for joint in robot.joints:
         poses[joint.child] = (
-            poses[joint.parent] @ joint_origin(joint) @ joint_motion(joint, values.get(joint.name, 0.0))
+            poses[joint.parent]
+            @ joint_origin(joint)
+            @ joint_motion(joint, values.get(joint.name, 0.0))
         )
     for frame in robot.frames:
         poses[frame.name] = poses[frame.parent] @ transform(frame.xyz, rpy_matrix(frame.rpy))

@@ -31,10 +31,18 @@ def volume_integrals(mesh: Mesh) -> tuple[float, np.ndarray, np.ndarray]:
     integ[4] = np.sum(cross[:, x] * f3[:, x])
     integ[5] = np.sum(cross[:, y] * f3[:, y])
     integ[6] = np.sum(cross[:, z] * f3[:, z])
-    integ[7] = np.sum(cross[:, x] * (v0[:, y] * g0[:, x] + v1[:, y] * g1[:, x] + v2[:, y] * g2[:, x]))
-    integ[8] = np.sum(cross[:, y] * (v0[:, z] * g0[:, y] + v1[:, z] * g1[:, y] + v2[:, z] * g2[:, y]))
-    integ[9] = np.sum(cross[:, z] * (v0[:, x] * g0[:, z] + v1[:, x] * g1[:, z] + v2[:, x] * g2[:, z]))
-    integ *= np.array([1 / 6, 1 / 24, 1 / 24, 1 / 24, 1 / 60, 1 / 60, 1 / 60, 1 / 120, 1 / 120, 1 / 120])
+    integ[7] = np.sum(
+        cross[:, x] * (v0[:, y] * g0[:, x] + v1[:, y] * g1[:, x] + v2[:, y] * g2[:, x])
+    )
+    integ[8] = np.sum(
+        cross[:, y] * (v0[:, z] * g0[:, y] + v1[:, z] * g1[:, y] + v2[:, z] * g2[:, y])
+    )
+    integ[9] = np.sum(
+        cross[:, z] * (v0[:, x] * g0[:, z] + v1[:, x] * g1[:, z] + v2[:, x] * g2[:, z])
+    )
+    integ *= np.array(
+        [1 / 6, 1 / 24, 1 / 24, 1 / 24, 1 / 60, 1 / 60, 1 / 60, 1 / 120, 1 / 120, 1 / 120]
+    )
     volume = integ[0]
     if volume <= 0:
         raise ValueError("mesh has no positive volume (open or inside-out)")

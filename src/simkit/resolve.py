@@ -161,8 +161,14 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         links=tuple(links),
         joints=joints,
         frames=tuple(
-            Frame(f.name, f.parent, tuple(float(v) for v in f.xyz), f.rpy_rad(), tuple(f.estimated),  # type: ignore[arg-type]
-                  f.site_size)
+            Frame(
+                f.name,
+                f.parent,
+                tuple(float(v) for v in f.xyz),
+                f.rpy_rad(),
+                tuple(f.estimated),  # type: ignore[arg-type]
+                f.site_size,
+            )
             for f in spec.frames
         ),
         materials=tuple((m.name, m.rgba) for m in spec.materials),

@@ -56,7 +56,9 @@ def primitive_solid(shape: Shape, base_dir: Path | None = None) -> mf.Manifold:
     elif kind == "capsule":
         half = shape.length / 2
         ball = mf.Manifold.sphere(shape.radius, CIRCULAR_SEGMENTS)
-        solid = mf.Manifold.batch_hull([ball.translate((0, 0, -half)), ball.translate((0, 0, half))])
+        solid = mf.Manifold.batch_hull(
+            [ball.translate((0, 0, -half)), ball.translate((0, 0, half))]
+        )
     elif kind == "mesh":
         solid = _load_mesh(shape, base_dir or Path("."))
     else:  # pragma: no cover - the schema only admits the kinds above

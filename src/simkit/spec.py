@@ -62,7 +62,9 @@ class Primitive(Placed):
     scale: PositiveFloat = 1.0
     subtract: bool = False
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, populate_by_name=True)
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, allow_inf_nan=False, populate_by_name=True
+    )
 
     @model_validator(mode="after")
     def _complete(self) -> Primitive:
@@ -101,7 +103,9 @@ class CollisionPrimitive(Placed):
     to: Vec3 | None = None
     geom_class: str | None = None
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, populate_by_name=True)
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, allow_inf_nan=False, populate_by_name=True
+    )
 
 
 class InertiaSpec(Strict):
@@ -189,8 +193,11 @@ class JointSpec(Placed):
 
     @model_validator(mode="after")
     def _units_once(self) -> JointSpec:
-        for rad, deg in (("lower", "lower_deg"), ("upper", "upper_deg"),
-                         ("max_velocity", "max_velocity_deg_s")):
+        for rad, deg in (
+            ("lower", "lower_deg"),
+            ("upper", "upper_deg"),
+            ("max_velocity", "max_velocity_deg_s"),
+        ):
             if getattr(self, rad) is not None and getattr(self, deg) is not None:
                 raise ValueError(f"give {rad} or {deg}, not both")
         if math.sqrt(sum(a * a for a in self.axis)) < 1e-9:

@@ -75,9 +75,12 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
         if not link.solid and link.collision != "primitives":
             yield ("links", i, "solid"), "a link needs a solid (its visual geometry)"
         if link.collision == "convex" and any(p.subtract or p.shape == "mesh" for p in link.solid):
-            yield ("links", i, "collision"), (
-                "'convex' needs a union of convex primitives (no mesh, no subtract); "
-                "use 'auto' or 'coacd'"
+            yield (
+                ("links", i, "collision"),
+                (
+                    "'convex' needs a union of convex primitives (no mesh, no subtract); "
+                    "use 'auto' or 'coacd'"
+                ),
             )
         allowed = set(type(link).model_fields) - {"name", "estimated", "note"}
         for k, field in enumerate(link.estimated):
@@ -119,8 +122,9 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
     for key in ("poses", "poses_deg"):
         for pose, values in getattr(spec, key).items():
             if len(values) != len(movable):
-                yield (key, pose), (
-                    f"pose '{pose}' has {len(values)} values for {len(movable)} movable joints"
+                yield (
+                    (key, pose),
+                    (f"pose '{pose}' has {len(values)} values for {len(movable)} movable joints"),
                 )
     for key in ("wrist_centre", "tool_frame"):
         value = getattr(spec, key)

@@ -12,7 +12,9 @@ def element(tag: str, attrib: dict[str, str] | None = None, **kw: str) -> ET.Ele
     return ET.Element(tag, {k: v for k, v in merged.items() if v is not None})
 
 
-def sub(parent: ET.Element, tag: str, attrib: dict[str, str] | None = None, **kw: str) -> ET.Element:
+def sub(
+    parent: ET.Element, tag: str, attrib: dict[str, str] | None = None, **kw: str
+) -> ET.Element:
     """Append a child element (see `element`)."""
     child = element(tag, attrib, **kw)
     parent.append(child)

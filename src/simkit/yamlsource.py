@@ -40,11 +40,16 @@ def _walk(node: yaml.Node, loc: Loc, lines: dict[Loc, int]) -> Any:
         for key_node, value_node in node.value:
             key = _CONSTRUCTOR.construct_object(key_node, deep=True)
             if not isinstance(key, str):
-                raise SpecError("", key_node.start_mark.line + 1, ".".join(map(str, loc)) or "<root>",
-                                f"keys must be strings, got {key!r}")
+                raise SpecError(
+                    "",
+                    key_node.start_mark.line + 1,
+                    ".".join(map(str, loc)) or "<root>",
+                    f"keys must be strings, got {key!r}",
+                )
             if key in out:
-                raise SpecError("", key_node.start_mark.line + 1, _dotted((*loc, key)),
-                                "duplicate key")
+                raise SpecError(
+                    "", key_node.start_mark.line + 1, _dotted((*loc, key)), "duplicate key"
+                )
             lines[(*loc, key)] = key_node.start_mark.line + 1
             out[key] = _walk(value_node, (*loc, key), lines)
             lines[(*loc, key)] = key_node.start_mark.line + 1

@@ -44,3 +44,29 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
     for check in (checks or CHECKS).values():
         findings.extend(check(kit))
     return findings
+
+
+#: Libraries whose behaviour the findings depend on (part of the cache key).
+CHECK_LIBRARIES = ("numpy", "scipy", "mujoco", "yourdfpy", "trimesh", "usd-core", "manifold3d")
+
+
+def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache) -> list[Finding]:
+    """`run_checks`, reusing the findings of an earlier build whose kit was byte-identical.
+
+    Checks are a pure function of the kit's bytes, simkit's code and the libraries that read
+    them, so those make the content-addressed key (issue 3: a warm rebuild re-runs no slow
+    pure step). Only passing results are stored; `simkit check` never uses the cache.
+    """
+    from dataclasses import asdict
+
+    from simkit.cache import code_digest, decode_json, encode_json, make_key
+
+    inputs = [part for path in sorted(files) for part in (path.encode("utf-8"), files[path])]
+    key = make_key("checks", 1, inputs, {"code": code_digest()}, CHECK_LIBRARIES)
+    stored = cache.get("checks", key)
+    if stored is not None:
+        return [Finding(**item) for item in decode_json(stored["findings"])]
+    findings = run_checks(kit_dir)
+    if all(f.ok for f in findings):
+        cache.put("checks", key, {"findings": encode_json([asdict(f) for f in findings])})
+    return findings

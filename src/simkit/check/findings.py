@@ -44,10 +44,13 @@ def compare(check: str, detail: str, expected, actual, tolerance: float, unit: s
     error = float(np.max(np.abs(exp - act))) if exp.size else 0.0
     ok = bool(np.isfinite(error) and error <= tolerance)
     return Finding(
-        check, ok, f"{detail} (worst error {error:.3g} {unit})".rstrip(),
+        check,
+        ok,
+        f"{detail} (worst error {error:.3g} {unit})".rstrip(),
         _g(exp) if exp.size <= 6 else f"{exp.size} values",
         _g(act) if act.size <= 6 else f"{act.size} values",
-        f"{tolerance:g}", unit,
+        f"{tolerance:g}",
+        unit,
     )
 
 

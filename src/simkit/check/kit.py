@@ -75,5 +75,7 @@ class Kit:
                 if joint["type"] == "prismatic":
                     out = out @ transform(np.asarray(joint["axis"]) * values[joint["name"]])
                 else:
-                    out = out @ transform((0, 0, 0), axis_angle(joint["axis"], values[joint["name"]]))
+                    out = out @ transform(
+                        (0, 0, 0), axis_angle(joint["axis"], values[joint["name"]])
+                    )
         return out @ tail

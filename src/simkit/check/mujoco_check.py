@@ -4,6 +4,7 @@ with robot.json, and with the published numbers."""
 from __future__ import annotations
 
 import re
+
 import mujoco
 import numpy as np
 
@@ -60,7 +61,9 @@ def check_models(kit: Kit) -> list[Finding]:
     findings: list[Finding] = []
     try:
         mj = load_mjcf(kit)
-        findings.append(require("mjcf.compile", True, f"{kit.mjcf} compiles in MuJoCo {mujoco.__version__}"))
+        findings.append(
+            require("mjcf.compile", True, f"{kit.mjcf} compiles in MuJoCo {mujoco.__version__}")
+        )
     except Exception as exc:  # MuJoCo raises ValueError with the compiler's message
         return [require("mjcf.compile", False, f"{kit.mjcf}: {exc}")]
     try:
@@ -73,16 +76,28 @@ def check_models(kit: Kit) -> list[Finding]:
     mass_json = [link["mass"] for link in kit.doc["links"]]
     mass_mj = [float(mj.body_mass[mj.body(n).id]) for n in links]
     mass_ur = [float(ur.body_mass[ur.body(n).id]) for n in links]
-    findings.append(compare("mass.mjcf", "per-link mass, MJCF vs robot.json", mass_json, mass_mj, 1e-6, "kg"))
-    findings.append(compare("mass.urdf", "per-link mass, URDF vs robot.json", mass_json, mass_ur, 1e-6, "kg"))
+    findings.append(
+        compare("mass.mjcf", "per-link mass, MJCF vs robot.json", mass_json, mass_mj, 1e-6, "kg")
+    )
+    findings.append(
+        compare("mass.urdf", "per-link mass, URDF vs robot.json", mass_json, mass_ur, 1e-6, "kg")
+    )
     inertia_mj = [mj.body_inertia[mj.body(n).id] for n in links]
     inertia_ur = [ur.body_inertia[ur.body(n).id] for n in links]
-    findings.append(compare("inertia.urdf_vs_mjcf", "principal inertia per link", inertia_mj,
-                            inertia_ur, 1e-7, "kg m^2"))
+    findings.append(
+        compare(
+            "inertia.urdf_vs_mjcf",
+            "principal inertia per link",
+            inertia_mj,
+            inertia_ur,
+            1e-7,
+            "kg m^2",
+        )
+    )
 
     names = [j["name"] for j in kit.joints]
     configs = random_configs(kit, N_RANDOM)
-    tool = kit.doc["tool_frame"] if "tool_frame" in kit.doc else None
+    tool = kit.doc.get("tool_frame", None)
     dmj, dur = mujoco.MjData(mj), mujoco.MjData(ur)
     qa, qb = _qpos_indices(mj, names), _qpos_indices(ur, names)
     va, vb = _dof_indices(mj, names), _dof_indices(ur, names)
@@ -101,14 +116,37 @@ def check_models(kit: Kit) -> list[Finding]:
             pos_ur.append((np.linalg.inv(T_w_base_ur) @ _body_pose(ur, dur, tool))[:3, 3])
             pos_json.append(kit.fk(q)[:3, 3])
     if tool:
-        findings.append(compare("fk.mjcf_vs_robot_json", f"{tool} at {N_RANDOM} random configurations",
-                                pos_json, pos_mj, 1e-6, "m"))
-        findings.append(compare("fk.urdf_vs_mjcf", f"{tool} at {N_RANDOM} random configurations",
-                                pos_mj, pos_ur, 1e-6, "m"))
+        findings.append(
+            compare(
+                "fk.mjcf_vs_robot_json",
+                f"{tool} at {N_RANDOM} random configurations",
+                pos_json,
+                pos_mj,
+                1e-6,
+                "m",
+            )
+        )
+        findings.append(
+            compare(
+                "fk.urdf_vs_mjcf",
+                f"{tool} at {N_RANDOM} random configurations",
+                pos_mj,
+                pos_ur,
+                1e-6,
+                "m",
+            )
+        )
     scale = max(1.0, float(np.abs(tau_mj).max()))
-    findings.append(compare("gravity.urdf_vs_mjcf", f"gravity torques at {N_RANDOM} random "
-                            "configurations", np.array(tau_mj) / scale, np.array(tau_ur) / scale,
-                            1e-6, "x max torque"))
+    findings.append(
+        compare(
+            "gravity.urdf_vs_mjcf",
+            f"gravity torques at {N_RANDOM} random configurations",
+            np.array(tau_mj) / scale,
+            np.array(tau_ur) / scale,
+            1e-6,
+            "x max torque",
+        )
+    )
     return findings
 
 
@@ -150,12 +188,21 @@ def check_hold(kit: Kit) -> list[Finding]:
                 data.ctrl[mj.actuator(name).id] = value
         mujoco.mj_forward(mj, data)
         contacts = int(data.ncon)
-        steps = int(round(HOLD_SECONDS / mj.opt.timestep))
+        steps = round(HOLD_SECONDS / mj.opt.timestep)
         for _ in range(steps):
             mujoco.mj_step(mj, data)
         error = np.degrees(np.abs(data.qpos[qa] - np.asarray(q)))
-        findings.append(compare("hold." + pose, f"servos hold '{pose}' for {HOLD_SECONDS:g} s",
-                                np.zeros_like(error), error, HOLD_TOLERANCE_DEG, "deg"))
-        findings.append(require("contact." + pose, contacts == 0,
-                                f"self-contacts at '{pose}': {contacts}"))
+        findings.append(
+            compare(
+                "hold." + pose,
+                f"servos hold '{pose}' for {HOLD_SECONDS:g} s",
+                np.zeros_like(error),
+                error,
+                HOLD_TOLERANCE_DEG,
+                "deg",
+            )
+        )
+        findings.append(
+            require("contact." + pose, contacts == 0, f"self-contacts at '{pose}': {contacts}")
+        )
     return findings

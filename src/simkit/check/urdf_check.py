@@ -22,12 +22,20 @@ def check_urdf(kit: Kit) -> list[Finding]:
         return [require("urdf.yourdfpy", False, f"yourdfpy cannot load {kit.urdf}: {exc}")]
     findings = [require("urdf.yourdfpy.validate", urdf.validate(), "yourdfpy validates the URDF")]
     missing = [
-        m.filename for link in urdf.robot.links for g in (link.visuals + link.collisions)
+        m.filename
+        for link in urdf.robot.links
+        for g in (link.visuals + link.collisions)
         if g.geometry.mesh is not None
-        for m in [g.geometry.mesh] if not (path.parent / m.filename).is_file()
+        for m in [g.geometry.mesh]
+        if not (path.parent / m.filename).is_file()
     ]
-    findings.append(require("urdf.meshes", not missing, f"mesh files missing: {missing[:3]}"
-                            if missing else "every mesh the URDF names exists"))
+    findings.append(
+        require(
+            "urdf.meshes",
+            not missing,
+            f"mesh files missing: {missing[:3]}" if missing else "every mesh the URDF names exists",
+        )
+    )
     tool = kit.doc.get("tool_frame")
     if tool:
         names = [j["name"] for j in kit.joints]
@@ -36,6 +44,14 @@ def check_urdf(kit: Kit) -> list[Finding]:
             urdf.update_cfg(dict(zip(names, q, strict=True)))
             T = urdf.get_transform(tool, kit.base_frame)
             errors.append(T[:3, 3] - kit.fk(q)[:3, 3])
-        findings.append(compare("fk.yourdfpy_vs_robot_json", f"{tool} at 10 random configurations",
-                                np.zeros((len(errors), 3)), errors, 1e-6, "m"))
+        findings.append(
+            compare(
+                "fk.yourdfpy_vs_robot_json",
+                f"{tool} at 10 random configurations",
+                np.zeros((len(errors), 3)),
+                errors,
+                1e-6,
+                "m",
+            )
+        )
     return findings

@@ -7,13 +7,22 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from simkit.emit import docs, meshes, mjcf, robot_json, urdf
-from simkit.emit import examples, ros2, srdf
-from simkit.emit import usd
-from simkit.emit import motion_files
-from simkit.emit import glb
-from simkit.emit import mjcf_scene
-from simkit.emit import ros2_control, validation
+from simkit.emit import (
+    docs,
+    examples,
+    glb,
+    meshes,
+    mjcf,
+    mjcf_scene,
+    motion_files,
+    robot_json,
+    ros2,
+    ros2_control,
+    srdf,
+    urdf,
+    usd,
+    validation,
+)
 from simkit.model import Robot
 
 Emitter = Callable[[Robot], dict[str, bytes]]

@@ -45,7 +45,9 @@ def context(robot: Robot) -> dict:
             "upper": _deg(j.upper),
             "velocity": _deg(j.max_velocity),
             "effort_peak": num(j.effort_peak, 4) if j.effort_peak else "",
-            "drive_peak": num(j.drive_peak_torque_at_joint, 4) if j.drive_peak_torque_at_joint else "",
+            "drive_peak": num(j.drive_peak_torque_at_joint, 4)
+            if j.drive_peak_torque_at_joint
+            else "",
             "armature": num(j.armature, 4),
         }
         for j in robot.movable_joints
@@ -79,8 +81,12 @@ def _floating(robot: Robot) -> dict:
     scene = "" if mjcf_world.servos_in_main(robot) else layout.mjcf_scene(robot.name)
     movable = robot.movable_joints
     return {
-        "floating": None if joint is None else {
-            "joint": joint.name, "child": joint.child, "xyz": ", ".join(num(v) for v in joint.xyz),
+        "floating": None
+        if joint is None
+        else {
+            "joint": joint.name,
+            "child": joint.child,
+            "xyz": ", ".join(num(v) for v in joint.xyz),
             "quat": ", ".join(num(v) for v in quat_wxyz(rpy_matrix(joint.rpy))),
         },
         "fixed_base": "False" if joint is not None else "True",

@@ -50,28 +50,58 @@ def _assets(robot: Robot, mujoco: ET.Element) -> None:
     meshdir = "meshes/"
     for link in robot.links:
         if link.solid is not None:
-            sub(asset, "mesh", name=_mesh_name(link.name),
-                file=layout.visual_mesh(link.name).removeprefix(meshdir))
+            sub(
+                asset,
+                "mesh",
+                name=_mesh_name(link.name),
+                file=layout.visual_mesh(link.name).removeprefix(meshdir),
+            )
         for i in range(len(link.collision)):
-            sub(asset, "mesh", name=_mesh_name(link.name, i),
-                file=layout.collision_mesh(link.name, i).removeprefix(meshdir))
+            sub(
+                asset,
+                "mesh",
+                name=_mesh_name(link.name, i),
+                file=layout.collision_mesh(link.name, i).removeprefix(meshdir),
+            )
     mjcf_world.assets(robot, asset)
 
 
 def _geoms(body: ET.Element, link: Link) -> None:
     if link.solid is not None:
-        sub(body, "geom", {"name": f"{link.name}_visual", "class": "visual",
-                           "mesh": _mesh_name(link.name), "material": link.material})
+        sub(
+            body,
+            "geom",
+            {
+                "name": f"{link.name}_visual",
+                "class": "visual",
+                "mesh": _mesh_name(link.name),
+                "material": link.material,
+            },
+        )
     if link.collision_primitives or link.collision_method == "primitives":
         for i, shape in enumerate(link.collision_primitives):
             _primitive(body, shape, f"{link.name}_collision_{i:02d}")
     elif link.collision:
         for i in range(len(link.collision)):
-            sub(body, "geom", {"name": f"{link.name}_collision_{i:02d}", "class": "collision",
-                               "mesh": _mesh_name(link.name, i)})
+            sub(
+                body,
+                "geom",
+                {
+                    "name": f"{link.name}_collision_{i:02d}",
+                    "class": "collision",
+                    "mesh": _mesh_name(link.name, i),
+                },
+            )
     elif link.solid is not None:
-        sub(body, "geom", {"name": f"{link.name}_collision_00", "class": "collision",
-                           "mesh": _mesh_name(link.name)})
+        sub(
+            body,
+            "geom",
+            {
+                "name": f"{link.name}_collision_00",
+                "class": "collision",
+                "mesh": _mesh_name(link.name),
+            },
+        )
 
 
 def _body(robot: Robot, parent: ET.Element, link_name: str) -> None:
@@ -80,13 +110,21 @@ def _body(robot: Robot, parent: ET.Element, link_name: str) -> None:
     body = sub(parent, "body", name=link.name, pos=vec(joint.xyz), quat=_quat(joint.rpy))
     if link.inertial is not None:
         ixx, iyy, izz, ixy, ixz, iyz = link.inertial.inertia
-        sub(body, "inertial", pos=vec(link.inertial.com), mass=num(link.inertial.mass),
-            fullinertia=vec((ixx, iyy, izz, ixy, ixz, iyz)))
+        sub(
+            body,
+            "inertial",
+            pos=vec(link.inertial.com),
+            mass=num(link.inertial.mass),
+            fullinertia=vec((ixx, iyy, izz, ixy, ixz, iyz)),
+        )
     if joint.type == "floating":
         sub(body, "freejoint", name=joint.name)
     elif joint.movable:
-        attrs = {"name": joint.name, "type": "slide" if joint.type == "prismatic" else "hinge",
-                 "axis": vec(joint.axis)}
+        attrs = {
+            "name": joint.name,
+            "type": "slide" if joint.type == "prismatic" else "hinge",
+            "axis": vec(joint.axis),
+        }
         if joint.type != "continuous" and joint.lower is not None:
             attrs["range"] = vec((joint.lower, joint.upper))
         attrs["armature"] = num(joint.armature)
@@ -100,8 +138,14 @@ def _body(robot: Robot, parent: ET.Element, link_name: str) -> None:
     _geoms(body, link)
     for frame in robot.frames:
         if frame.parent == link.name:
-            sub(body, "site", name=frame.name, pos=vec(frame.xyz), quat=_quat(frame.rpy),
-                size=num(frame.site_size) if frame.site_size else "0.005")
+            sub(
+                body,
+                "site",
+                name=frame.name,
+                pos=vec(frame.xyz),
+                quat=_quat(frame.rpy),
+                size=num(frame.site_size) if frame.site_size else "0.005",
+            )
     mjcf_world.cameras(robot, body, link.name)
     for child in robot.joints:
         if child.parent == link.name:
@@ -118,10 +162,19 @@ def emit(robot: Robot) -> dict[str, bytes]:
     """`mjcf/NAME.xml`."""
     file = layout.mjcf(robot.name)
     mujoco = ET.Element("mujoco", model=robot.name)
-    sub(mujoco, "compiler", angle="radian", meshdir=layout.relative(file, "meshes"),
-        autolimits="true")
-    sub(mujoco, "option", timestep=num(mjcf_world.timestep(robot, TIMESTEP)),
-        integrator="implicitfast")
+    sub(
+        mujoco,
+        "compiler",
+        angle="radian",
+        meshdir=layout.relative(file, "meshes"),
+        autolimits="true",
+    )
+    sub(
+        mujoco,
+        "option",
+        timestep=num(mjcf_world.timestep(robot, TIMESTEP)),
+        integrator="implicitfast",
+    )
     mjcf_world.visual(robot, mujoco)
     default = sub(sub(mujoco, "default"), "default", {"class": robot.name})
     visual = sub(default, "default", {"class": "visual"})

@@ -96,7 +96,11 @@ def _frames(robot: Robot) -> dict:
                 "height": joint.xyz[2],
             }
     for frame in robot.frames:
-        frames[frame.name] = {"parent": frame.parent, "xyz": list(frame.xyz), "rpy": list(frame.rpy)}
+        frames[frame.name] = {
+            "parent": frame.parent,
+            "xyz": list(frame.xyz),
+            "rpy": list(frame.rpy),
+        }
     return frames
 
 
@@ -120,17 +124,27 @@ def document(robot: Robot) -> dict:
         "title": robot.title,
         "description": robot.description,
         "units": {"length": "m", "mass": "kg", "angle": "rad", "time": "s", "torque": "N m"},
-        "files": {"urdf": layout.urdf(robot.name), "mjcf": layout.mjcf(robot.name),
-                  "glb": layout.glb(robot.name)},
+        "files": {
+            "urdf": layout.urdf(robot.name),
+            "mjcf": layout.mjcf(robot.name),
+            "glb": layout.glb(robot.name),
+        },
         "base_frame": robot.derived.get("base_frame", robot.root),
         "tool_frame": robot.tool_frame,
         "wrist_centre": robot.wrist_centre,
-        "joints": [_joint(j, robot.derived.get("joint_json", {}).get(j.name))
-                   for j in robot.movable_joints],
+        "joints": [
+            _joint(j, robot.derived.get("joint_json", {}).get(j.name)) for j in robot.movable_joints
+        ],
         "fixed_joints": [
-            {"name": j.name, "parent": j.parent, "child": j.child, "origin_xyz": list(j.xyz),
-             "origin_rpy": list(j.rpy)}
-            for j in robot.joints if j.type == "fixed"
+            {
+                "name": j.name,
+                "parent": j.parent,
+                "child": j.child,
+                "origin_xyz": list(j.xyz),
+                "origin_rpy": list(j.rpy),
+            }
+            for j in robot.joints
+            if j.type == "fixed"
         ],
         "links": [_link(link) for link in robot.links],
         "frames": _frames(robot),
@@ -138,13 +152,18 @@ def document(robot: Robot) -> dict:
         "poses": poses,
         "fk_reference": robot.derived.get("fk_reference", []),
         "reach": {
-            "published": {"wrist": published.get("reach_wrist"), "flange": published.get("reach_flange")},
+            "published": {
+                "wrist": published.get("reach_wrist"),
+                "flange": published.get("reach_flange"),
+            },
             "geometric": geometric,
             "note": "geometric reach: distance of the wrist centre and of tool0 from the J1 axis "
             "at the stretched pose",
         },
-        "payload": {"rated": published.get("payload"),
-                    "estimate": "payload" in robot.published_estimated},
+        "payload": {
+            "rated": published.get("payload"),
+            "estimate": "payload" in robot.published_estimated,
+        },
         "repeatability_mm": published.get("repeatability_mm"),
         "published": published,
         "mass": {"published": published.get("mass"), "model": robot.total_mass},
@@ -158,7 +177,13 @@ def document(robot: Robot) -> dict:
             "links": robot.derived.get("geometry_links", []),
         },
         "actuators": [
-            {"joint": a.joint, "type": "position", "kp": a.kp, "kv": a.kv, "forcerange": a.forcerange}
+            {
+                "joint": a.joint,
+                "type": "position",
+                "kp": a.kp,
+                "kv": a.kv,
+                "forcerange": a.forcerange,
+            }
             for a in robot.actuators
         ],
         "provenance": {
@@ -191,8 +216,11 @@ def _generalise(robot: Robot, doc: dict) -> None:
     floating = robot.floating_joint
     if floating is not None:
         doc["floating_base"] = {
-            "joint": floating.name, "parent": floating.parent, "child": floating.child,
-            "origin_xyz": list(floating.xyz), "origin_rpy": list(floating.rpy),
+            "joint": floating.name,
+            "parent": floating.parent,
+            "child": floating.child,
+            "origin_xyz": list(floating.xyz),
+            "origin_rpy": list(floating.rpy),
             "note": "MJCF free joint; the URDF's root is the child link (no world joint); "
             "MuJoCo qpos starts with its position (m) and quaternion (w, x, y, z)",
         }

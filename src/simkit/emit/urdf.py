@@ -26,9 +26,7 @@ def _primitive_geometry(parent: ET.Element, shape: Shape) -> None:
         sub(geometry, "box", size=vec(shape.size))
     elif shape.kind == "sphere":
         sub(geometry, "sphere", radius=num(shape.radius))
-    elif shape.kind == "cylinder":
-        sub(geometry, "cylinder", radius=num(shape.radius), length=num(shape.length))
-    elif shape.kind == "capsule":  # URDF 1.0 has no capsule: ROS readers take the cylinder
+    elif shape.kind == "cylinder" or shape.kind == "capsule":
         sub(geometry, "cylinder", radius=num(shape.radius), length=num(shape.length))
 
 
@@ -68,8 +66,16 @@ def _link(robot: Robot, root: ET.Element, link: Link, file: str) -> None:
         _origin(inertial, link.inertial.com, (0, 0, 0))
         sub(inertial, "mass", value=num(link.inertial.mass))
         ixx, iyy, izz, ixy, ixz, iyz = link.inertial.inertia
-        sub(inertial, "inertia", ixx=num(ixx), ixy=num(ixy), ixz=num(ixz), iyy=num(iyy),
-            iyz=num(iyz), izz=num(izz))
+        sub(
+            inertial,
+            "inertia",
+            ixx=num(ixx),
+            ixy=num(ixy),
+            ixz=num(ixz),
+            iyy=num(iyy),
+            iyz=num(iyz),
+            izz=num(izz),
+        )
     if link.solid is not None:
         visual = sub(el, "visual", name=f"{link.name}_visual")
         _origin(visual, (0, 0, 0), (0, 0, 0))
