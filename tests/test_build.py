@@ -123,8 +123,9 @@ def test_warm_rebuild_reuses_check_findings_of_identical_kit(tmp_path):
     assert cold.stats.misses.get("checks") == 1 and not cold.stats.hits.get("checks")
     warm = Cache.at(tmp_path / "cache")
     second = build(str(spec), tmp_path / "b", cache=warm)
-    assert warm.stats.hits.get("checks") == 1
+    assert warm.stats.hits.get("checks") == 1 and warm.stats.hits.get("emit") == 1
     assert second.findings == first.findings and all(f.ok for f in second.findings)
+    assert second.files == first.files
     # a different kit (one changed byte in the spec's title) is checked afresh
     changed = tmp_path / "planar_2r.yaml"
     changed.write_text(spec.read_text().replace("title: Planar 2R", "title: Planar 2R arm"))

@@ -71,6 +71,51 @@ def model_from_spec(
     return derive_all(robot, path.parent, cache, jobs, progress)
 
 
+#: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
+EMIT_LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core", "jinja2")
+
+
+def _emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes]:
+    """`emit_all`, reusing the files of an earlier build of an identical model.
+
+    Emitters are pure functions of the model and the templates (no clock, no randomness), so
+    the key is the model's content digest, simkit's source digest, every template's bytes,
+    the library versions and the options. On
+    a hit no emitter runs, so a warm rebuild does not even import pxr. Stored as one byte
+    blob plus a JSON index (no pickle), through the cache's digest-checked entries.
+    """
+    import numpy as np
+
+    from simkit.cache import code_digest, decode_json, digest, encode_json, make_key
+
+    templates = data_dir("templates")
+    template_bytes = [
+        part
+        for path in sorted(templates.rglob("*"))
+        if path.is_file()
+        for part in (path.relative_to(templates).as_posix().encode(), path.read_bytes())
+    ]
+    key = make_key(
+        "emit",
+        1,
+        [digest(robot).encode(), code_digest().encode(), *template_bytes],
+        {"usd_format": usd_format},
+        EMIT_LIBRARIES,
+    )
+    stored = cache.get("emit", key)
+    if stored is not None:
+        blob = stored["blob"].tobytes()
+        return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
+    files = emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)})
+    index, offset = [], 0
+    for path, data in files.items():
+        index.append([path, offset, offset + len(data)])
+        offset += len(data)
+    blob = np.frombuffer(b"".join(files.values()), dtype=np.uint8)
+    cache.put("emit", key, {"index": encode_json(index), "blob": blob})
+    return files
+
+
 def write_tree(root: Path, files: dict[str, bytes]) -> None:
     """Write `files` (POSIX relative paths) under `root`."""
     for rel, data in files.items():
@@ -106,7 +151,7 @@ def build(
     cache = Cache.at() if cache is None else cache
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
-    files = emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)})
+    files = _emit_cached(robot, usd_format, cache)
     out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
     staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))
