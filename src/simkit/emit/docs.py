@@ -6,11 +6,12 @@ import math
 from functools import cache
 
 import jinja2
+import numpy as np
 
 from simkit import layout
 from simkit.emit import mjcf_world
 from simkit.fmt import num
-from simkit.kinematics import quat_wxyz, rpy_matrix
+from simkit.kinematics import chain, quat_wxyz, rpy_matrix
 from simkit.model import Robot
 from simkit.resources import data_dir
 
@@ -53,7 +54,8 @@ def context(robot: Robot) -> dict:
         for j in robot.movable_joints
     ]
     poses = {name: ", ".join(num(math.degrees(v), 4) for v in q) for name, q in robot.poses}
-    demo = [num(v, 4) for v in dict(robot.poses).get("work", ())]
+    demo_pose = "work" if "work" in dict(robot.poses) else "home"
+    demo = [num(math.degrees(v), 6) for v in dict(robot.poses).get(demo_pose, ())]
     return {
         "robot": robot.name,
         "title": robot.title,
@@ -69,8 +71,38 @@ def context(robot: Robot) -> dict:
         "n_movable": len(robot.movable_joints),
         "has_actuators": bool(robot.actuators) and mjcf_world.servos_in_main(robot),
         "demo_q": demo,
+        "demo_pose": demo_pose,
         "sources": list(robot.sources),
         **_floating(robot),
+        **_fk_snippet(robot),
+    }
+
+
+def _fk_snippet(robot: Robot) -> dict:
+    """Which robot.json FK snippet the README can show. `fk` is "page" for the kit page's own
+    snippet (pure-translation origins, tool frame = last link turned 180 deg about x),
+    "general" when the movable joints form one chain to the tool frame, else ""."""
+    tool = next((f for f in robot.frames if f.name == robot.tool_frame), None)
+    movable = list(robot.movable_joints)
+    if tool is None or not movable:
+        return {"fk": "", "fk_pose": "", "fk_base": ""}
+    try:
+        path = [j for j in chain(robot, movable[0].parent, tool.parent) if j.movable]
+    except ValueError:
+        return {"fk": "", "fk_pose": "", "fk_base": ""}
+    if path != movable:
+        return {"fk": "", "fk_pose": "", "fk_base": ""}
+    names = [name for name, _ in robot.poses]
+    pose = "stretched" if "stretched" in names else next((n for n in names if n != "home"), "")
+    page = (
+        all(j.rpy == (0.0, 0.0, 0.0) for j in movable)
+        and tool.xyz == (0.0, 0.0, 0.0)
+        and np.allclose(rpy_matrix(tool.rpy), np.diag([1.0, -1.0, -1.0]))
+    )
+    return {
+        "fk": "page" if page else "general",
+        "fk_pose": pose or "home",
+        "fk_base": movable[0].parent,
     }
 
 
