@@ -107,3 +107,19 @@ def test_robot_json_fk_snippet(rosie_1000):
     out = _run(rosie_1000.kit_dir, FK_SNIPPET)
     np.testing.assert_allclose(_floats(out[0]), [1.077, 0.0, 0.230], atol=1e-4)
     np.testing.assert_allclose(_floats(out[1]), [0.530, 0.0, 0.623], atol=1e-4)
+
+
+def test_pybullet_sees_no_phantom_mass_on_frames(rosie_1000):
+    """PyBullet gives a URDF link without <inertial> 1 kg; tool0 must weigh nothing."""
+    code = """
+import pybullet as p
+p.connect(p.DIRECT)
+robot = p.loadURDF("urdf/rosie_1000.urdf", useFixedBase=True, flags=p.URDF_USE_INERTIA_FROM_FILE)
+masses = {p.getJointInfo(robot, i)[12].decode(): p.getDynamicsInfo(robot, i)[0]
+          for i in range(p.getNumJoints(robot))}
+print("MASSES", sorted(masses.items()))
+"""
+    line = next(x for x in _run(rosie_1000.kit_dir, code) if "MASSES" in x)
+    masses = dict(eval(line[line.index("[") :]))  # noqa: S307 - our own printed literal
+    assert masses["tool0"] == 0.0
+    assert abs(sum(masses.values()) - 38.6 + 6.0) < 1e-9  # links below base_link

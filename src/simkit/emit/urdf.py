@@ -87,6 +87,16 @@ def _link(robot: Robot, root: ET.Element, link: Link, file: str) -> None:
         el.append(col)
 
 
+def _massless(link: ET.Element) -> None:
+    """An explicit zero inertial: PyBullet gives a link without one 1 kg and 1 kg m^2
+    (BulletUrdfImporter: "No inertial data for link, using mass=1"), a phantom payload on
+    tool0 that changes the wrist torques by several percent."""
+    inertial = sub(link, "inertial")
+    _origin(inertial, (0, 0, 0), (0, 0, 0))
+    sub(inertial, "mass", value="0")
+    sub(inertial, "inertia", ixx="0", ixy="0", ixz="0", iyy="0", iyz="0", izz="0")
+
+
 def _joint(root: ET.Element, joint: Joint) -> None:
     el = sub(root, "joint", name=joint.name, type=joint.type)
     sub(el, "parent", link=joint.parent)
@@ -123,6 +133,6 @@ def emit(robot: Robot) -> dict[str, bytes]:
         sub(joint, "parent", link=frame.parent)
         sub(joint, "child", link=frame.name)
         _origin(joint, frame.xyz, frame.rpy)
-        sub(root, "link", name=frame.name)
+        _massless(sub(root, "link", name=frame.name))
     root.extend(ros2_control.urdf_elements(robot))  # spec `ros2_control:` only; else nothing
     return {file: to_bytes(root, HEADER.format(spec=robot.spec_file))}
