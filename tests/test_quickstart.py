@@ -122,4 +122,4 @@ print("MASSES", sorted(masses.items()))
     line = next(x for x in _run(rosie_1000.kit_dir, code) if "MASSES" in x)
     masses = dict(eval(line[line.index("[") :]))  # noqa: S307 - our own printed literal
     assert masses["tool0"] == 0.0
-    assert abs(sum(masses.values()) - 38.6 + 6.0) < 1e-9  # links below base_link
+    assert abs(sum(masses.values()) - 38.6) < 1e-9  # exactly the robot mass
