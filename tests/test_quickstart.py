@@ -120,6 +120,6 @@ masses = {p.getJointInfo(robot, i)[12].decode(): p.getDynamicsInfo(robot, i)[0]
 print("MASSES", sorted(masses.items()))
 """
     line = next(x for x in _run(rosie_1000.kit_dir, code) if "MASSES" in x)
-    masses = dict(eval(line[line.index("[") :]))  # noqa: S307 - our own printed literal
+    masses = dict(eval(line[line.index("[") :]))
     assert masses["tool0"] == 0.0
     assert abs(sum(masses.values()) - 38.6) < 1e-9  # exactly the robot mass
