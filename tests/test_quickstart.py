@@ -3,6 +3,7 @@ changed (robot.json is read from the kit instead of the web)."""
 
 from __future__ import annotations
 
+import ast
 import subprocess
 import sys
 import textwrap
@@ -120,6 +121,6 @@ masses = {p.getJointInfo(robot, i)[12].decode(): p.getDynamicsInfo(robot, i)[0]
 print("MASSES", sorted(masses.items()))
 """
     line = next(x for x in _run(rosie_1000.kit_dir, code) if "MASSES" in x)
-    masses = dict(eval(line[line.index("[") :]))
+    masses = dict(ast.literal_eval(line[line.index("[") :]))
     assert masses["tool0"] == 0.0
     assert abs(sum(masses.values()) - 38.6) < 1e-9  # exactly the robot mass
