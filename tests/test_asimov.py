@@ -19,7 +19,7 @@ from simkit.build import BuildResult
 from simkit.check.kit import Kit
 from simkit.check.legged_check import check_drop, check_stand
 from simkit.errors import SpecError
-from simkit.validate import validate
+from simkit.validate import load_spec, validate
 from simkit.yamlsource import load_yaml
 
 REPO = Path(__file__).resolve().parents[1]
@@ -99,6 +99,28 @@ def test_joint_ranges_axes_and_toe_spring(model):
         assert toe.margin[0] == pytest.approx(0.01)
         for joint in ACTUATED:
             assert model.joint(f"{side}_{joint}_joint").damping[0] == 0.0
+
+
+def test_spec_transcribes_the_reference_exactly():
+    """The spec carries the reference's numbers as printed (the MJCF tests compare normalised
+    axes with a tolerance, which would not notice a re-typed value)."""
+    spec = load_spec(REPO / "robots/asimov.yaml")[0]
+    joints = {j.name: j for j in spec.joints}
+    assert joints["left_hip_pitch_joint"].axis == (0, 0.70711, -0.70711)
+    assert joints["right_hip_pitch_joint"].axis == (0, -0.70711, -0.70711)  # y mirrored
+    for side, y in (("left", 0.99994), ("right", -0.99994)):
+        toe = joints[f"{side}_toe_joint"]
+        assert toe.axis == (0.010532, y, 0)
+        assert (toe.stiffness, toe.springref, toe.damping, toe.friction) == (4.5, 0, 0.5, 0.02)
+        assert toe.solreflimit == (0.005, 1) and toe.solimplimit == (0.99, 0.999, 0.001)
+        assert (toe.margin, toe.armature, toe.actuated) == (0.01, 0.01, False)
+    assert all(j.armature == 0.01 for j in spec.joints if j.type != "floating")
+    pelvis = spec.links[0]
+    assert (pelvis.name, pelvis.mass) == ("pelvis_link", 3.3125)
+    assert pelvis.com == (-0.00071228, -3.4719e-07, -0.073826)
+    inertia = pelvis.inertia
+    assert (inertia.ixx, inertia.iyy, inertia.izz) == (0.0033117, 0.0028238, 0.003564)
+    assert joints["floating_base_joint"].xyz == (0, 0, 0.739)
 
 
 def _tensor(model: mujoco.MjModel, body: str) -> np.ndarray:
@@ -351,6 +373,11 @@ def _spec_with(tmp_path: Path, old: str, new: str) -> Path:
         ),
         ("objname: imu_in_pelvis", "objname: imu", "mjcf.sensors[2].objname: unknown site 'imu'"),
         ("body: pelvis_link, mode: track", "body: pelvis, mode: track", "mjcf.cameras[0].body"),
+        (  # rnea.py integrates a fixed-base tree only
+            "seed: 0\n",
+            "seed: 0\nfreefall: {pose: home}\n",
+            "freefall: the free-fall validation needs a fixed base",
+        ),
     ],
 )
 def test_spec_errors_name_the_field(tmp_path, old, new, field):

@@ -66,6 +66,53 @@ def test_check_passes_on_built_kit_and_fails_on_tampered_copy(rosie_1000, tmp_pa
     assert "FAIL mass.mjcf" in proc.stdout and "expected" in proc.stdout
 
 
+# (file, text in the kit, tampered text, the check that must fail): one per number the kit
+# page fixes in the URDF and MJCF ("Simulation parameters") and the tool frame's orientation.
+TAMPER = [
+    ("urdf", 'effort="150"', 'effort="15"', "urdf.effort"),
+    ("urdf", 'velocity="3.141592654"', 'velocity="31.41592654"', "urdf.velocity"),
+    ("urdf", 'lower="-2.35619449"', 'lower="-1.35619449"', "urdf.limits"),
+    ("urdf", 'damping="0.8"', 'damping="8"', "urdf.dynamics"),
+    ("urdf", 'rpy="3.141592654 0 0"', 'rpy="0 0 0"', "fk.yourdfpy_vs_robot_json.rotation"),
+    ("mjcf", 'quat="0 1 0 0"', 'quat="1 0 0 0"', "fk.mjcf_vs_robot_json.rotation"),
+    ("mjcf", 'kp="15000"', 'kp="150000"', "mjcf.servo_gains"),
+    ("mjcf", 'kv="346.4866122"', 'kv="34.64866122"', "mjcf.servo_gains"),
+    ("mjcf", 'forcerange="-191.9 191.9"', 'forcerange="-150 150"', "mjcf.forcerange"),
+    ("mjcf", 'ctrlrange="-2.792526803', 'ctrlrange="-1.792526803', "mjcf.ctrlrange"),
+    ("mjcf", 'armature="0.357035"', 'armature="0.0357035"', "mjcf.joint_dynamics"),
+    ("mjcf", 'range="-2.792526803', 'range="-1.792526803', "mjcf.range"),
+    ("mjcf", '<exclude body1="link_3" body2="link_4" />', "", "mjcf.excludes"),
+    (
+        "mjcf",
+        '<exclude body1="link_3" body2="link_4" />',
+        '<exclude body1="link_3" body2="link_4" /><exclude body1="link_1" body2="link_5" />',
+        "mjcf.excludes",
+    ),
+]
+
+
+@pytest.mark.parametrize(("kind", "old", "new", "check"), TAMPER, ids=[t[3] for t in TAMPER])
+def test_checks_catch_a_tampered_urdf_or_mjcf(rosie_1000, tmp_path, kind, old, new, check):
+    from simkit.check.mujoco_check import check_models, check_parameters
+    from simkit.check.urdf_check import check_urdf
+
+    checks = {"models": check_models, "mjcf_parameters": check_parameters, "urdf": check_urdf}
+    assert all(f.ok for f in run_checks(rosie_1000.kit_dir, checks))
+    copy = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, copy)
+    path = copy / ("urdf/rosie_1000.urdf" if kind == "urdf" else "mjcf/rosie_1000.xml")
+    text = path.read_text()
+    assert old in text, old
+    # ctrlrange and range: a trailing space or quote tells the two apart
+    if old.startswith('range="'):
+        text = text.replace(" " + old, " " + new, 1)
+    else:
+        text = text.replace(old, new, 1)
+    path.write_text(text)
+    failed = {f.check for f in run_checks(copy, checks) if not f.ok}
+    assert check in failed
+
+
 def test_kit_layout_and_zip(rosie_1000):
     kit = rosie_1000.kit_dir
     assert kit.name == "rosie_1000_description"

@@ -115,6 +115,22 @@ def test_drive_armature_and_peak_torque(doc, mj):
     assert (j1["lower"], j1["upper"]) == (-3.211405854, 0.0698132)
 
 
+def test_joint_limits_friction_in_urdf_and_mjcf(urdf, mj):
+    """Report section 4: joint_1 limit -3.211405854 .. 0.0698132 rad, effort 100, velocity 10,
+    damping 0, friction 0.01, as written in the URDF and the MJCF (not only robot.json)."""
+    for name in ("joint_1", "joint_2"):
+        joint = urdf.find(f"joint[@name='{name}']")
+        limit, dynamics = joint.find("limit").attrib, joint.find("dynamics").attrib
+        assert (float(limit["effort"]), float(limit["velocity"])) == (100, 10)
+        assert (float(dynamics["damping"]), float(dynamics["friction"])) == (0, 0.01)
+        dof = mj.joint(name).dofadr[0]
+        assert (mj.dof_damping[dof], mj.dof_frictionloss[dof]) == (0, 0.01)
+    limit = urdf.find("joint[@name='joint_1']/limit").attrib
+    assert (limit["lower"], limit["upper"]) == ("-3.211405854", "0.0698132")
+    assert tuple(mj.joint("joint_1").range) == (-3.211405854, 0.0698132)
+    assert mj.jnt_limited[mj.joint("joint_1").id]
+
+
 def test_world_mounting(doc, urdf, mj):
     """The fixed world joint (report section 4 step 1) puts the joint axes horizontal, so the
     arm swings in a vertical plane; the MJCF has it as link_0's body pose."""

@@ -2,15 +2,20 @@
 
 from __future__ import annotations
 
+import itertools
 import json
+import re
+from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+import yaml
 import yourdfpy
 
 from simkit.build import model_from_spec
 from simkit.dynamics import gravity_torques
+from simkit.mjcompat import full_mass_matrix
 
 # Kit page (000_5f76ade803e16979.txt), table "Robot | Wrist centre | Published reach | tool0 at
 # home | Mass" and "Frames and conventions".
@@ -25,6 +30,8 @@ PUBLISHED = {
         wrist=1.4337, reach=(1.400, 1.499), tool0=(0.834, 0, 0.756), height=0.0294, mass=77.0
     ),
 }
+JOINTS = [f"joint_{i}" for i in range(1, 7)]
+REPO = Path(__file__).resolve().parents[1]
 MM = 1e-4  # 0.1 mm
 KG = 0.01
 AXES = [(0, 0, 1), (0, 1, 0), (0, 1, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
@@ -90,13 +97,80 @@ def test_urdf_numbers(kit):
     assert urdf.base_link == "base_footprint"
     T = urdf.get_transform("tool0", "base_link")
     np.testing.assert_allclose(T[:3, 3], pub["tool0"], atol=MM)
+    # tool0: z out of the flange (down at home), x along base +x
+    np.testing.assert_allclose(T[:3, :3], np.diag([1, -1, -1]), atol=1e-9)
     assert abs(urdf.get_transform("base_link", "base_footprint")[2, 3] - pub["height"]) < MM
     mass = sum(link.inertial.mass for link in urdf.robot.links if link.inertial is not None)
     assert abs(mass - pub["mass"]) < KG
-    for joint in urdf.robot.joints:
-        if joint.type == "revolute":
-            assert joint.limit.effort > 0 and joint.limit.velocity > 0
-            assert "../meshes/" in (result.kit_dir / f"urdf/{name}.urdf").read_text()
+    urdf.update_cfg(dict(zip(JOINTS, np.radians([0, 90, -90, 0, 0, 0]), strict=True)))
+    wrist = urdf.get_transform("link_5", "base_link")[:3, 3]
+    assert abs(np.hypot(wrist[0], wrist[1]) - pub["wrist"]) < MM
+
+
+def _spec_joints(name: str) -> list[dict]:
+    """The movable joints as the spec file states them (independent of the pipeline)."""
+    doc = yaml.safe_load((REPO / "robots" / f"{name}.yaml").read_text())
+    return [j for j in doc["joints"] if j.get("type", "revolute") == "revolute"]
+
+
+def test_urdf_simulation_parameters(kit):
+    """Kit page, "Simulation parameters": URDF effort = effort_peak, velocity = the maximum
+    joint speed; mesh paths relative to the file (../meshes/)."""
+    name, result = kit
+    text = (result.kit_dir / f"urdf/{name}.urdf").read_text()
+    urdf = yourdfpy.URDF.load(str(result.kit_dir / f"urdf/{name}.urdf"), load_meshes=False)
+    joints = {j.name: j for j in urdf.robot.joints}
+    for spec in _spec_joints(name):
+        limit = joints[spec["name"]].limit
+        assert limit.effort == pytest.approx(spec["effort_peak"], rel=1e-9), spec["name"]
+        speed = np.radians(spec["max_velocity_deg_s"])
+        assert limit.velocity == pytest.approx(speed, rel=1e-9), spec["name"]
+        assert limit.lower == pytest.approx(np.radians(spec["lower_deg"]), rel=1e-9)
+        assert limit.upper == pytest.approx(np.radians(spec["upper_deg"]), rel=1e-9)
+    meshes = re.findall(r'filename="([^"]+)"', text)
+    assert meshes and all(m.startswith("../meshes/") for m in meshes)
+    assert all((result.kit_dir / "urdf" / m).is_file() for m in meshes)
+
+
+def test_mjcf_simulation_parameters(kit):
+    """Kit page, "Simulation parameters": position servos with ctrl in radians, kp =
+    effort_peak per 0.01 rad, critically damped (kv = 2 sqrt(kp M_ii) with MuJoCo's own mass
+    matrix at home, armature included), forcerange = drive_peak_torque_at_joint (motor peak x
+    ratio), armature = reflected rotor inertia, damping from the spec; site tool0; collisions
+    excluded between adjacent links only."""
+    name, result = kit
+    model = mujoco.MjModel.from_xml_path(str(result.kit_dir / f"mjcf/{name}.xml"))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    full = full_mass_matrix(model, data)
+    assert model.nu == 6
+    for i, spec in enumerate(_spec_joints(name)):
+        act = model.actuator(spec["name"])
+        joint = model.joint(spec["name"])
+        assert model.actuator_trnid[act.id, 0] == joint.id
+        kp = spec["effort_peak"] / 0.01
+        assert act.gainprm[0] == pytest.approx(kp, rel=1e-9)
+        assert tuple(act.biasprm[:2]) == pytest.approx((0.0, -kp), rel=1e-9)
+        dof = model.jnt_dofadr[joint.id]
+        assert -act.biasprm[2] == pytest.approx(2 * np.sqrt(kp * full[dof, dof]), rel=1e-8)
+        drive = spec["drive"]
+        peak = drive["motor_peak_torque"] * drive["gear_ratio"]
+        assert peak >= spec["effort_peak"]
+        assert tuple(act.forcerange) == pytest.approx((-peak, peak), rel=1e-9)
+        limits = np.radians([spec["lower_deg"], spec["upper_deg"]])
+        assert tuple(act.ctrlrange) == pytest.approx(tuple(limits), rel=1e-9)
+        assert tuple(model.jnt_range[joint.id]) == pytest.approx(tuple(limits), rel=1e-9)
+        armature = drive["rotor_inertia"] * drive["gear_ratio"] ** 2
+        assert model.dof_armature[dof] == pytest.approx(armature, rel=1e-9)
+        assert model.dof_damping[dof] == pytest.approx(spec["damping"], rel=1e-9)
+        assert i == dof
+    assert model.site("tool0").id >= 0
+    bodies = ["base_link", *[f"link_{i}" for i in range(1, 7)]]
+    excluded = {
+        tuple(sorted((model.body(s >> 16).name, model.body(s & 0xFFFF).name)))
+        for s in model.exclude_signature
+    }
+    assert excluded == {tuple(sorted(pair)) for pair in itertools.pairwise(bodies)}
 
 
 @pytest.mark.parametrize("name", sorted(PUBLISHED))

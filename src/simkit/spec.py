@@ -200,9 +200,14 @@ class JointSpec(Placed):
         ):
             if getattr(self, rad) is not None and getattr(self, deg) is not None:
                 raise ValueError(f"give {rad} or {deg}, not both")
-        if math.sqrt(sum(a * a for a in self.axis)) < 1e-9:
-            raise ValueError("axis must not be zero")
         return self
+
+    @field_validator("axis")
+    @classmethod
+    def _nonzero_axis(cls, axis: Vec3) -> Vec3:
+        if math.sqrt(sum(a * a for a in axis)) < 1e-9:
+            raise ValueError("axis must not be zero")
+        return axis
 
 
 class FrameSpec(Placed):

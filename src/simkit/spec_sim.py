@@ -150,3 +150,11 @@ def problems(spec, inertia_problem) -> Iterator[Problem]:
     ff = spec.freefall
     if ff is not None and ff.pose not in {**spec.poses, **spec.poses_deg}:
         yield ("freefall", "pose"), f"unknown pose '{ff.pose}'"
+    if ff is not None and spec.floating_base:
+        # rnea.py integrates the joints of a fixed-base tree; a free base would fall away in
+        # MuJoCo while the independent side holds it, a meaningless comparison
+        yield (
+            ("freefall",),
+            "the free-fall validation needs a fixed base (the report's arm is welded to the "
+            "world); remove `freefall:` or `floating_base`",
+        )

@@ -6,6 +6,7 @@ field, plus a count of the rest, as yourdfpy's validation does.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -103,6 +104,12 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield ("joints", i, field), f"lower ({lower}) is greater than upper ({upper})"
         if joint.type in ("revolute", "prismatic") and (lower is None or upper is None):
             yield ("joints", i, "type"), f"a {joint.type} joint needs lower and upper limits"
+        peak, continuous = joint.effort_peak, joint.effort_continuous
+        if peak is not None and continuous is not None and continuous > peak:
+            yield (
+                ("joints", i, "effort_continuous"),
+                f"effort_continuous ({continuous:g}) is greater than effort_peak ({peak:g})",
+            )
         allowed = set(type(joint).model_fields) - {"name", "estimated"}
         for k, field in enumerate(joint.estimated):
             if field not in allowed:
@@ -225,12 +232,47 @@ def validate(doc: SourceDoc) -> RobotSpec:
     except ValidationError as exc:
         raise _first(_pydantic_problems(exc), doc) from None
     problems = list(_cross_reference(spec))
+    if not problems:  # the joint tree is sound: poses can be read in the model's joint order
+        problems = list(_pose_limits(spec))
     if problems:
         raise _first(problems, doc)
     return spec
 
 
+def _pose_limits(spec: RobotSpec) -> Iterator[Problem]:
+    """Every named pose lies within the joint limits. Pose values follow the model's joint
+    order (depth-first, `resolve.py`), as `Robot.pose` reads them."""
+    from simkit.kinematics import tree_order
+    from simkit.resolve import joint_of
+
+    joints = [j for j in tree_order([joint_of(j) for j in spec.joints], spec.root) if j.movable]
+    for key, scale in (("poses", 1.0), ("poses_deg", math.pi / 180)):
+        for pose, values in getattr(spec, key).items():
+            for k, (joint, value) in enumerate(zip(joints, values, strict=True)):
+                if joint.type == "continuous" or joint.lower is None or joint.upper is None:
+                    continue
+                q = value * scale
+                if not joint.lower - 1e-9 <= q <= joint.upper + 1e-9:
+                    yield (
+                        (key, pose, k),
+                        f"pose '{pose}' puts {joint.name} at {value:g}"
+                        f"{' deg' if scale != 1.0 else ''}, outside its limits",
+                    )
+
+
+def _mesh_files(spec: RobotSpec, base_dir: Path) -> Iterator[Problem]:
+    """Mesh primitives name files (relative to the spec) that exist."""
+    for i, link in enumerate(spec.links):
+        for k, prim in enumerate(link.solid):
+            if prim.shape == "mesh" and prim.file and not (base_dir / prim.file).is_file():
+                yield ("links", i, "solid", k, "file"), f"mesh file not found: {prim.file}"
+
+
 def load_spec(path: Path, display: str | None = None) -> tuple[RobotSpec, SourceDoc]:
     """Read and validate one spec file."""
     doc = load_yaml(path, display)
-    return validate(doc), doc
+    spec = validate(doc)
+    problems = list(_mesh_files(spec, path.parent))
+    if problems:
+        raise _first(problems, doc)
+    return spec, doc

@@ -14,7 +14,7 @@ from simkit.check.geometry_check import check_collision, check_glb
 from simkit.check.kit import Kit
 from simkit.check.legged_check import check_legged
 from simkit.check.motion_check import check_motion
-from simkit.check.mujoco_check import check_hold, check_models
+from simkit.check.mujoco_check import check_hold, check_models, check_parameters
 from simkit.check.published import check_published
 from simkit.check.ros_check import check_ros
 from simkit.check.urdf_check import check_urdf
@@ -25,6 +25,7 @@ Check = Callable[[Kit], list[Finding]]
 CHECKS: dict[str, Check] = {
     "published": check_published,
     "models": check_models,
+    "mjcf_parameters": check_parameters,
     "urdf": check_urdf,
     "collision": check_collision,
     "glb": check_glb,

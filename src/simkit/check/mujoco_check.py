@@ -14,6 +14,8 @@ from simkit.check.kit import Kit
 N_RANDOM = 25
 HOLD_SECONDS = 2.0
 HOLD_TOLERANCE_DEG = 0.5  # kit page: "a held pose sits within a few tenths of a degree"
+PARAM_TOL = 1e-6  # MJCF and robot.json both carry 10 significant digits (fmt.num, jsonout)
+_JOINT = mujoco.mjtObj.mjOBJ_JOINT
 
 
 def load_mjcf(kit: Kit) -> mujoco.MjModel:
@@ -102,6 +104,7 @@ def check_models(kit: Kit) -> list[Finding]:
     qa, qb = _qpos_indices(mj, names), _qpos_indices(ur, names)
     va, vb = _dof_indices(mj, names), _dof_indices(ur, names)
     pos_mj, pos_ur, pos_json, tau_mj, tau_ur = [], [], [], [], []
+    rot_mj, rot_ur, rot_json = [], [], []
     for q in configs:
         dmj.qpos[qa], dur.qpos[qb] = q, q
         mujoco.mj_forward(mj, dmj)
@@ -112,9 +115,15 @@ def check_models(kit: Kit) -> list[Finding]:
             base = kit.base_frame
             T_w_base_mj = _body_pose(mj, dmj, base)
             T_w_base_ur = _body_pose(ur, dur, base)
-            pos_mj.append((np.linalg.inv(T_w_base_mj) @ _site_or_body_pose(mj, dmj, tool))[:3, 3])
-            pos_ur.append((np.linalg.inv(T_w_base_ur) @ _body_pose(ur, dur, tool))[:3, 3])
-            pos_json.append(kit.fk(q)[:3, 3])
+            T_mj = np.linalg.inv(T_w_base_mj) @ _site_or_body_pose(mj, dmj, tool)
+            T_ur = np.linalg.inv(T_w_base_ur) @ _body_pose(ur, dur, tool)
+            T_json = kit.fk(q)
+            pos_mj.append(T_mj[:3, 3])
+            pos_ur.append(T_ur[:3, 3])
+            pos_json.append(T_json[:3, 3])
+            rot_mj.append(T_mj[:3, :3])
+            rot_ur.append(T_ur[:3, :3])
+            rot_json.append(T_json[:3, :3])
     if tool:
         findings.append(
             compare(
@@ -136,6 +145,20 @@ def check_models(kit: Kit) -> list[Finding]:
                 "m",
             )
         )
+        for check, expected, actual in (
+            ("fk.mjcf_vs_robot_json.rotation", rot_json, rot_mj),
+            ("fk.urdf_vs_mjcf.rotation", rot_mj, rot_ur),
+        ):
+            findings.append(
+                compare(
+                    check,
+                    f"{tool} rotation at {N_RANDOM} random configurations (matrix entries)",
+                    expected,
+                    actual,
+                    1e-6,
+                    "",
+                )
+            )
     scale = max(1.0, float(np.abs(tau_mj).max()))
     findings.append(
         compare(
@@ -206,3 +229,123 @@ def check_hold(kit: Kit) -> list[Finding]:
             require("contact." + pose, contacts == 0, f"self-contacts at '{pose}': {contacts}")
         )
     return findings
+
+
+def _movable(kit: Kit) -> list[dict]:
+    return [j for j in kit.joints if j["type"] in ("revolute", "continuous", "prismatic")]
+
+
+def check_parameters(kit: Kit) -> list[Finding]:
+    """The MJCF carries robot.json's numbers (kit page, "Simulation parameters"): each joint's
+    range, armature, damping and friction loss; each position servo's kp, kv, force range
+    (drive_peak_torque_at_joint) and control range (the joint limits, radians); and contact
+    exclusions between adjacent links only."""
+    mj = load_mjcf(kit)
+    joints = _movable(kit)
+    missing = [j["name"] for j in joints if mujoco.mj_name2id(mj, _JOINT, j["name"]) < 0]
+    if missing:
+        return [require("mjcf.joints", False, f"joints missing from the MJCF: {missing}")]
+    ids = [mj.joint(j["name"]).id for j in joints]
+    dofs = [int(mj.jnt_dofadr[i]) for i in ids]
+    limited = [(j, i) for j, i in zip(joints, ids, strict=True) if _is_limited(j)]
+    findings = [
+        compare(
+            "mjcf.range",
+            "joint ranges vs robot.json lower/upper",
+            [[j["lower"], j["upper"]] for j, _ in limited],
+            [mj.jnt_range[i] if mj.jnt_limited[i] else (np.nan, np.nan) for _, i in limited],
+            PARAM_TOL,
+            "rad or m",
+        ),
+        compare(
+            "mjcf.joint_dynamics",
+            "armature, damping, friction loss vs robot.json",
+            [[j["armature"], j["damping"], j["friction"]] for j in joints],
+            np.column_stack(
+                [mj.dof_armature[dofs], mj.dof_damping[dofs], mj.dof_frictionloss[dofs]]
+            ),
+            PARAM_TOL,
+            "SI",
+        ),
+        _excludes(kit, mj),
+    ]
+    servos = [a for a in kit.doc.get("actuators", []) if a.get("type") == "position"]
+    if servos:
+        findings.extend(_servos(kit, load_control_mjcf(kit), servos))
+    return findings
+
+
+def _is_limited(joint: dict) -> bool:
+    return joint["type"] != "continuous" and joint["lower"] is not None
+
+
+def _servos(kit: Kit, mj: mujoco.MjModel, servos: list[dict]) -> list[Finding]:
+    """Position servos in the control MJCF vs robot.json `actuators` and joints."""
+    joints = {j["name"]: j for j in kit.joints}
+    names = [mj.actuator(i).name for i in range(mj.nu)]
+    missing = [a["joint"] for a in servos if a["joint"] not in names]
+    if missing:
+        return [require("mjcf.servos", False, f"no position servo for {missing}")]
+    acts = [mj.actuator(a["joint"]) for a in servos]
+    on_joint = [
+        int(act.trntype[0]) == mujoco.mjtTrn.mjTRN_JOINT
+        and mj.joint(int(act.trnid[0])).name == a["joint"]
+        for act, a in zip(acts, servos, strict=True)
+    ]
+    peak = [joints[a["joint"]]["drive_peak_torque_at_joint"] for a in servos]
+    limited = [
+        (a, act) for a, act in zip(servos, acts, strict=True) if _is_limited(joints[a["joint"]])
+    ]
+    return [
+        require("mjcf.servos", all(on_joint), "each position servo drives its own joint"),
+        compare(
+            "mjcf.servo_gains",
+            "servo kp, kv vs robot.json actuators",
+            [[a["kp"], a["kv"]] for a in servos],
+            # a position servo: gain kp; bias (0, -kp, -kv)
+            [[act.gainprm[0], -act.biasprm[2]] for act in acts],
+            PARAM_TOL,
+            "N m/rad, N m s/rad",
+        ),
+        compare(
+            "mjcf.forcerange",
+            "servo force range vs robot.json actuators and drive_peak_torque_at_joint",
+            [[-a["forcerange"], a["forcerange"], -p, p] for a, p in zip(servos, peak, strict=True)],
+            [
+                [*act.forcerange, *act.forcerange] if act.forcelimited[0] else [np.nan] * 4
+                for act in acts
+            ],
+            PARAM_TOL,
+            "N m or N",
+        ),
+        compare(
+            "mjcf.ctrlrange",
+            "servo control range (radians) vs robot.json joint limits",
+            [[joints[a["joint"]]["lower"], joints[a["joint"]]["upper"]] for a, _ in limited],
+            [act.ctrlrange if act.ctrllimited[0] else (np.nan, np.nan) for _, act in limited],
+            PARAM_TOL,
+            "rad or m",
+        ),
+    ]
+
+
+def _excludes(kit: Kit, mj: mujoco.MjModel) -> Finding:
+    """MJCF <exclude> pairs are exactly the links joined by a joint."""
+    links = {link["name"] for link in kit.doc["links"]}
+    adjacent = {
+        tuple(sorted((j["parent"], j["child"])))
+        for j in kit.joints + kit.doc.get("fixed_joints", [])
+        if j["parent"] in links and j["child"] in links
+    }
+    excluded = set()
+    for sig in mj.exclude_signature:
+        a, b = int(sig) >> 16, int(sig) & 0xFFFF
+        excluded.add(tuple(sorted((mj.body(a).name, mj.body(b).name))))
+    extra, lacking = sorted(excluded - adjacent), sorted(adjacent - excluded)
+    return require(
+        "mjcf.excludes",
+        not extra and not lacking,
+        "contacts excluded between adjacent links only"
+        + (f"; not adjacent but excluded: {extra}" if extra else "")
+        + (f"; adjacent but not excluded: {lacking}" if lacking else ""),
+    )

@@ -154,30 +154,39 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
         axes_exp.append(np.concatenate([mj.jnt_axis[jid], mj.jnt_pos[jid]]))
         axes_act.append(np.concatenate([usd.pose1[:3, :3] @ usd.axis, usd.pose1[:3, 3]]))
         act = actuated.get(jid)
-        if bool(mj.jnt_limited[jid]) != (usd.limit is not None) or (
-            (act is None) != (usd.drive is None)
+        dof, qadr = int(mj.jnt_dofadr[jid]), int(mj.jnt_qposadr[jid])
+        # a joint without a servo but with MJCF stiffness or damping is a passive spring-damper:
+        # a force drive aimed at springref (qpos_spring) with no force limit
+        spring = act is None and bool(mj.jnt_stiffness[jid] or mj.dof_damping[dof])
+        if (
+            bool(mj.jnt_limited[jid]) != (usd.limit is not None)
+            or (act is None and not spring) != (usd.drive is None)
+            or (spring and usd.drive is not None and math.isfinite(usd.drive[2]))
         ):
             odd.append(doc["name"])
             continue
+        unit = math.radians if usd.kind == "revolute" else float  # USD: degrees
         if usd.limit is not None:
-            unit = math.radians if usd.kind == "revolute" else float  # USD: degrees
             lim_exp.append(mj.jnt_range[jid])
             lim_act.append([unit(v) for v in usd.limit])
-        if act is not None:
+        if usd.drive is not None:
             per = 180.0 / math.pi if usd.kind == "revolute" else 1.0  # USD: gains per degree
-            drv_exp.append(
-                [
-                    mj.actuator_gainprm[act, 0],
-                    -mj.actuator_biasprm[act, 2],
-                    mj.actuator_forcerange[act, 1],
-                ]
+            if act is not None:
+                gains = [mj.actuator_gainprm[act, 0], -mj.actuator_biasprm[act, 2]]
+                max_force, target = mj.actuator_forcerange[act, 1], 0.0
+            else:
+                gains = [mj.jnt_stiffness[jid], mj.dof_damping[dof]]
+                max_force, target = math.inf, mj.qpos_spring[qadr]  # no limit: not compared
+            drv_exp.append([*gains, max_force, target])
+            drv_act.append(
+                [usd.drive[0] * per, usd.drive[1] * per, usd.drive[2], unit(usd.drive[3])]
             )
-            drv_act.append([usd.drive[0] * per, usd.drive[1] * per, usd.drive[2]])
     findings += [
         require(
             "usd.limits_drives",
             not odd,
-            f"limits and drives where the MJCF has a range and a servo (differ: {odd})",
+            f"limits and drives where the MJCF has a range, a servo or a passive spring-damper "
+            f"(differ: {odd})",
         ),
         compare(
             "usd.axes",
@@ -197,16 +206,22 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
         ),
     ]
     for i, (what, unit) in enumerate(
-        (("stiffness", "N m/rad"), ("damping", "N m s/rad"), ("maxForce", "N m"))
+        (
+            ("stiffness", "N m/rad"),
+            ("damping", "N m s/rad"),
+            ("maxForce", "N m"),
+            ("targetPosition", "rad"),
+        )
     ):
-        exp = [row[i] for row in drv_exp]
+        rows = [(e[i], a[i]) for e, a in zip(drv_exp, drv_act, strict=True) if math.isfinite(e[i])]
+        exp = [e for e, _ in rows]
         findings.append(
             compare(
                 f"usd.drive.{what}",
-                f"DriveAPI {what} vs MJCF servo",
+                f"DriveAPI {what} vs MJCF servo or passive spring-damper",
                 exp,
-                [row[i] for row in drv_act],
-                _tol(exp),
+                [a for _, a in rows],
+                max(_tol(exp), 1e-9),
                 unit,
             )
         )

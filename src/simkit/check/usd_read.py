@@ -27,7 +27,8 @@ class UsdJoint:
     pose1: np.ndarray
     axis: np.ndarray
     limit: tuple[float, float] | None  # deg (revolute) or m (prismatic)
-    drive: tuple[float, float, float] | None  # stiffness, damping, max force (USD units)
+    #: stiffness, damping, max force, target position (USD units: per degree, degrees)
+    drive: tuple[float, float, float, float] | None
 
 
 def matrix(pos, quat) -> np.ndarray:
@@ -104,6 +105,7 @@ def joints_from_parser(parsed: dict) -> list[UsdJoint]:
                         float(d.drive.stiffness),
                         float(d.drive.damping),
                         float(d.drive.forceLimit),
+                        float(d.drive.targetPosition),
                     )
             out.append(
                 UsdJoint(
@@ -153,6 +155,7 @@ def joints_from_schemas(stage) -> list[UsdJoint]:
                     float(api.GetStiffnessAttr().Get()),
                     float(api.GetDampingAttr().Get()),
                     float(api.GetMaxForceAttr().Get()),
+                    float(api.GetTargetPositionAttr().Get() or 0.0),
                 )
         out.append(
             UsdJoint(

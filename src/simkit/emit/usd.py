@@ -302,17 +302,27 @@ def _joint(stage, root: str, robot: Robot, joint) -> None:
         schema.CreateLowerLimitAttr(rounded(unit(joint.lower)))
         schema.CreateUpperLimitAttr(rounded(unit(joint.upper)))
     actuator = next((a for a in robot.actuators if a.joint == joint.name), None)
-    if actuator is None:
-        return
-    # MJCF position servo: tau = kp (q_ref - q) - kv qdot, |tau| <= forcerange. UsdPhysics
-    # DriveAPI angular gains are per degree (stiffness N m/deg, damping N m s/deg).
+    # UsdPhysics DriveAPI angular gains are per degree (stiffness N m/deg, damping N m s/deg)
+    # and its target position is in degrees.
     per = math.pi / 180.0 if angular else 1.0
+    if actuator is not None:
+        # MJCF position servo: tau = kp (q_ref - q) - kv qdot, |tau| <= forcerange.
+        gains, max_force, target = (actuator.kp, actuator.kv), actuator.forcerange, 0.0
+    elif joint.stiffness or joint.damping:
+        # A passive spring-damper (MJCF joint stiffness, springref, damping; e.g. Asimov's toes,
+        # 001_71a395c46b8a5939.txt "Toe Joints"): tau = -k (q - springref) - d qdot is a force
+        # drive aimed at springref with no force limit (maxForce left at its default, inf).
+        gains, max_force = (joint.stiffness, joint.damping), None
+        target = math.degrees(joint.springref) if angular else joint.springref
+    else:
+        return
     drive = UsdPhysics.DriveAPI.Apply(schema.GetPrim(), "angular" if angular else "linear")
     drive.CreateTypeAttr("force")
-    drive.CreateStiffnessAttr(rounded(actuator.kp * per))
-    drive.CreateDampingAttr(rounded(actuator.kv * per))
-    drive.CreateMaxForceAttr(rounded(actuator.forcerange))
-    drive.CreateTargetPositionAttr(0.0)
+    drive.CreateStiffnessAttr(rounded(gains[0] * per))
+    drive.CreateDampingAttr(rounded(gains[1] * per))
+    if max_force is not None:
+        drive.CreateMaxForceAttr(rounded(max_force))
+    drive.CreateTargetPositionAttr(rounded(target))
 
 
 def stage_text(robot: Robot) -> str:
