@@ -75,6 +75,16 @@ TAMPER = [
     ("urdf", 'damping="0.8"', 'damping="8"', "urdf.dynamics"),
     ("urdf", 'rpy="3.141592654 0 0"', 'rpy="0 0 0"', "fk.yourdfpy_vs_robot_json.rotation"),
     ("mjcf", 'quat="0 1 0 0"', 'quat="1 0 0 0"', "fk.mjcf_vs_robot_json.rotation"),
+    # base_link's CoM and tensor orientation: no joint moves it, so no torque shows them
+    ("urdf", 'xyz="-0.00333113457 0 -0.04950452243"', 'xyz="0 0 -0.04950452243"', "com.urdf"),
+    ("urdf", 'ixz="-0.001401866609"', 'ixz="0.001401866609"', "inertia.urdf"),
+    ("mjcf", 'pos="-0.00333113457 0 -0.04950452243"', 'pos="0 0 -0.0495045224"', "com.mjcf"),
+    (
+        "mjcf",
+        "0.02511500894 0 -0.001401866609 0",
+        "0.02511500894 0 0.001401866609 0",
+        "inertia.mjcf",
+    ),
     ("mjcf", 'kp="15000"', 'kp="150000"', "mjcf.servo_gains"),
     ("mjcf", 'kv="346.4866122"', 'kv="34.64866122"', "mjcf.servo_gains"),
     ("mjcf", 'forcerange="-191.9 191.9"', 'forcerange="-150 150"', "mjcf.forcerange"),
@@ -113,6 +123,32 @@ def test_checks_catch_a_tampered_urdf_or_mjcf(rosie_1000, tmp_path, kind, old, n
     assert check in failed
 
 
+def test_check_of_a_kit_missing_a_file_fails_without_a_traceback(rosie_1000, tmp_path):
+    """A damaged kit (here: no MJCF) gives failed findings naming the file, not a crash."""
+    copy = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, copy)
+    (copy / "mjcf/rosie_1000.xml").unlink()
+    failed = {f.check: f for f in run_checks(copy) if not f.ok}
+    assert "mjcf.compile" in failed and "hold.error" in failed
+    assert "rosie_1000.xml" in failed["hold.error"].detail
+    assert all("\n" not in f.line() for f in failed.values())
+
+
+def test_check_writes_nothing_into_the_kit(rosie_1000, tmp_path):
+    """`simkit check` reads a kit as it is (it may be read-only or checked twice at once):
+    no check writes into it (compiling the URDF in MuJoCo uses a copy elsewhere)."""
+    from simkit.check.kit import Kit
+    from simkit.check.mujoco_check import load_urdf_in_mujoco
+
+    copy = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, copy)
+    folders = [copy, *(p for p in copy.rglob("*") if p.is_dir())]
+    before = {p: p.stat().st_mtime_ns for p in folders}
+    assert load_urdf_in_mujoco(Kit.open(copy)).nmesh > 0
+    assert all(f.ok for f in run_checks(copy))
+    assert {p: p.stat().st_mtime_ns for p in folders} == before
+
+
 def test_kit_layout_and_zip(rosie_1000):
     kit = rosie_1000.kit_dir
     assert kit.name == "rosie_1000_description"
@@ -138,6 +174,17 @@ def test_kit_layout_and_zip(rosie_1000):
         )
     doc = json.loads((kit / "robot.json").read_text())
     assert "/" not in doc["provenance"]["spec"].split("robots/")[0]  # no absolute paths
+
+
+def test_no_absolute_paths_in_any_kit_file(rosie_1000):
+    """No file of the kit (or the zip, which holds the same bytes) names the build folder,
+    the repository or the home folder: kits are relocatable and reproducible."""
+    needles = {str(p).encode() for p in (rosie_1000.kit_dir.parent, REPO, Path.home())}
+    for path, data in rosie_1000.files.items():
+        if path.endswith((".stl", ".glb", ".usdc")):  # binary geometry: no text to carry a path
+            continue
+        hits = [n for n in needles if n in data]
+        assert not hits, (path, hits)
 
 
 def test_cli_list_and_version():

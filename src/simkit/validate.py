@@ -114,6 +114,12 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
         for k, field in enumerate(joint.estimated):
             if field not in allowed:
                 yield ("joints", i, "estimated", k), f"'{field}' is not a field of a joint"
+        if joint.drive is not None:
+            allowed = set(type(joint.drive).model_fields) - {"estimated"}
+            for k, field in enumerate(joint.drive.estimated):
+                if field not in allowed:
+                    loc = ("joints", i, "drive", "estimated", k)
+                    yield loc, f"'{field}' is not a field of a drive"
     for i, link in enumerate(spec.links):
         if link.name not in children:
             yield ("links", i, "name"), f"link '{link.name}' is not the child of any joint"
@@ -133,6 +139,8 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
                     (key, pose),
                     (f"pose '{pose}' has {len(values)} values for {len(movable)} movable joints"),
                 )
+    for pose in sorted(set(spec.poses) & set(spec.poses_deg)):
+        yield ("poses_deg", pose), f"pose '{pose}' is given in both poses and poses_deg"
     for key in ("wrist_centre", "tool_frame"):
         value = getattr(spec, key)
         if value is not None and value not in names_seen:

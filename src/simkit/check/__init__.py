@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from simkit.check.findings import Finding
+from simkit.check.findings import Finding, require
 from simkit.check.freefall_check import check_freefall
 from simkit.check.geometry_check import check_collision, check_glb
 from simkit.check.kit import Kit
@@ -42,8 +42,12 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
     """Every finding for the kit at `kit_dir`, in a stable order."""
     kit = Kit.open(kit_dir)
     findings: list[Finding] = []
-    for check in (checks or CHECKS).values():
-        findings.extend(check(kit))
+    for name, check in (checks or CHECKS).items():
+        try:
+            findings.extend(check(kit))
+        except Exception as exc:  # a damaged kit (missing or unreadable file): fail, no traceback
+            why = " ".join(f"{type(exc).__name__}: {exc}".split())
+            findings.append(require(f"{name}.error", False, f"the {name} check cannot run: {why}"))
     return findings
 
 

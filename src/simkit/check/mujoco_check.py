@@ -4,6 +4,8 @@ with robot.json, and with the published numbers."""
 from __future__ import annotations
 
 import re
+import tempfile
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -31,15 +33,20 @@ def load_control_mjcf(kit: Kit) -> mujoco.MjModel:
 def load_urdf_in_mujoco(kit: Kit) -> mujoco.MjModel:
     """Compile the URDF in MuJoCo, keeping fixed frames as bodies and the relative mesh paths
     (MuJoCo's URDF reader strips directories unless told not to)."""
-    text = kit.path(kit.urdf).read_text(encoding="utf-8")
+    urdf = kit.path(kit.urdf)
+    text = urdf.read_text(encoding="utf-8")
     ext = '<mujoco><compiler strippath="false" fusestatic="false" discardvisual="true"/></mujoco>'
     text = re.sub(r"(<robot\b[^>]*>)", r"\1" + ext, text, count=1)
-    tmp = kit.path(kit.urdf).with_name(".simkit_check.urdf")
-    tmp.write_text(text, encoding="utf-8")
-    try:
-        return mujoco.MjModel.from_xml_path(str(tmp))
-    finally:
-        tmp.unlink(missing_ok=True)
+    # mesh paths made absolute, so the copy can live outside the kit (which may be read-only)
+    text = re.sub(
+        r'filename="([^"]+)"',
+        lambda m: f'filename="{(urdf.parent / m.group(1)).resolve().as_posix()}"',
+        text,
+    )
+    with tempfile.TemporaryDirectory(prefix="simkit-check-") as tmp:
+        copy = Path(tmp) / urdf.name
+        copy.write_text(text, encoding="utf-8")
+        return mujoco.MjModel.from_xml_path(str(copy))
 
 
 def _qpos_indices(model: mujoco.MjModel, names: list[str]) -> list[int]:
@@ -96,6 +103,7 @@ def check_models(kit: Kit) -> list[Finding]:
             "kg m^2",
         )
     )
+    findings.extend(_inertials(kit, links, mj, ur))
 
     names = [j["name"] for j in kit.joints]
     configs = random_configs(kit, N_RANDOM)
@@ -171,6 +179,56 @@ def check_models(kit: Kit) -> list[Finding]:
         )
     )
     return findings
+
+
+def _inertial_frame(model: mujoco.MjModel, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """CoM (m) and inertia tensor about it (kg m^2), both in the body (link) frame."""
+    body = model.body(name)
+    rot = np.zeros(9)
+    mujoco.mju_quat2Mat(rot, body.iquat)
+    rot = rot.reshape(3, 3)
+    return np.array(body.ipos), rot @ np.diag(body.inertia) @ rot.T
+
+
+def _inertials(kit: Kit, links: list[str], mj: mujoco.MjModel, ur: mujoco.MjModel):
+    """Each link's CoM and full inertia tensor (orientation included) in the MJCF and in the
+    URDF vs robot.json. Principal moments and gravity torques alone miss a turned tensor, and
+    the CoM of links that no horizontal joint moves (base_link, link_1)."""
+    com_json, tensor_json = [], []
+    for link in kit.doc["links"]:
+        i = link["inertia"]
+        com_json.append(link["com"])
+        tensor_json.append(
+            [
+                [i["ixx"], i["ixy"], i["ixz"]],
+                [i["ixy"], i["iyy"], i["iyz"]],
+                [i["ixz"], i["iyz"], i["izz"]],
+            ]
+        )
+    out = []
+    for label, model in (("mjcf", mj), ("urdf", ur)):
+        frames = [_inertial_frame(model, n) for n in links]
+        out.append(
+            compare(
+                f"com.{label}",
+                f"CoM per link in the link frame, {label.upper()} vs robot.json",
+                com_json,
+                [com for com, _ in frames],
+                1e-6,
+                "m",
+            )
+        )
+        out.append(
+            compare(
+                f"inertia.{label}",
+                f"inertia tensor per link in the link frame, {label.upper()} vs robot.json",
+                tensor_json,
+                [tensor for _, tensor in frames],
+                1e-7,
+                "kg m^2",
+            )
+        )
+    return out
 
 
 def _body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
