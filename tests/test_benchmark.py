@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import shutil
 
 import numpy as np
 import pytest
@@ -20,26 +21,53 @@ def kit(rosie_1000) -> Kit:
     return Kit.open(rosie_1000.kit_dir)
 
 
-@pytest.fixture(scope="module")
-def samples(kit) -> tuple[list[str], np.ndarray]:
+def _samples(kit: Kit) -> tuple[list[str], np.ndarray]:
     path = kit.path(kit.doc["benchmarks"]["trajectory_files"]["cycle_1kg"]["csv"])
-    assert path.name == "rosie_1000_cycle_1kg.csv"
+    assert path.name == f"{kit.name}_cycle_1kg.csv"
     with path.open(encoding="utf-8", newline="") as handle:
         rows = list(csv.reader(handle))
     return rows[0], np.array(rows[1:], dtype=float)
 
 
-def test_path_points_follow_the_page(kit):
+@pytest.fixture(scope="module")
+def samples(kit) -> tuple[list[str], np.ndarray]:
+    return _samples(kit)
+
+
+#: Kit page, "Benchmark cycle": low points 50 mm above base_link, 75.5 mm on the Rosie 1400.
+LOW_POINTS = {"rosie_600": 0.050, "rosie_1000": 0.050, "rosie_1400": 0.0755}
+
+
+@pytest.mark.parametrize("name", sorted(LOW_POINTS))
+def test_path_points_follow_the_page(kit_factory, name):
+    kit = Kit.open(kit_factory(name).kit_dir)
     path = kit.doc["benchmarks"]["path"]
     points = path["tcp_points_base_link_m"]
     a_low, a_high, b_high, b_low = (np.array(points[n]) for n in benchmark.POINTS)
     assert np.linalg.norm(b_low - a_low) == pytest.approx(0.305)  # along y
     assert (a_low + b_low)[:2] / 2 == pytest.approx([0.350, 0.0])  # 350 mm out on +x
-    assert a_low[2] == b_low[2] == pytest.approx(0.050)  # 50 mm above base_link
+    assert a_low[2] == b_low[2] == pytest.approx(LOW_POINTS[name])  # above base_link
     assert a_high - a_low == pytest.approx([0, 0, 0.025])
     assert b_high - b_low == pytest.approx([0, 0, 0.025])
     assert path["sequence"] == ["A_low", "A_high", "B_high", "B_low", "B_high", "A_high", "A_low"]
     assert kit.doc["benchmarks"]["tcp"]["xyz"] == [0, 0, 0.05]
+    assert np.linalg.norm(b_low - a_low) == pytest.approx(abs(b_low[1] - a_low[1]))  # along y
+    # tool straight down with its heading kept, reached by the trajectory's own q (robot.json FK)
+    bench = kit.doc["benchmarks"]
+    _, data = _samples(kit)
+    ends = np.rint(np.cumsum([0.0, *bench["segment_times"]["cycle_1kg"]]) / 0.001).astype(int)
+    for row in ends:
+        rotation = kit.fk(data[row, 1:7])[:3, :3]
+        assert np.abs(rotation - np.diag([1.0, -1.0, -1.0])).max() < 1e-9
+    for cycle in ("cycle_1kg", "cycle_rated"):
+        payload = bench["payload"][cycle]
+        x, y, z = payload["com_xyz"]  # 100 mm along the tool axis, 50 mm off it
+        assert z == pytest.approx(0.100) and math.hypot(x, y) == pytest.approx(0.050)
+        assert payload["inertia_diag"] == pytest.approx([payload["mass"] * 0.1**2 / 6] * 3)
+    assert bench["payload"]["cycle_1kg"]["mass"] == 1
+    assert bench["payload"]["cycle_rated"]["mass"] == kit.doc["payload"]["rated"]
+    check = bench["kit_model_check"]
+    assert 0 < max(check["fraction"]) <= 1
 
 
 def test_csv_at_1ms_within_speed_and_acceleration(kit, samples):
@@ -124,3 +152,26 @@ def test_json_trajectory_matches_csv(kit, samples):
     assert doc["dt"] == 0.001 and len(doc["segments"]) == 6
     assert np.array_equal(np.asarray(doc["q"]), data[:, 1:7])
     assert np.array_equal(np.asarray(doc["tcp"]), data[:, 19:22])
+
+
+def test_check_catches_columns_that_do_not_describe_one_motion(kit, tmp_path):
+    """Every other sample dropped (the motion played twice as fast) keeps the qd and qdd
+    columns within their bounds, but q no longer integrates qd and qd changes twice as fast
+    as the benchmark acceleration allows: the check must fail."""
+    copy = tmp_path / "kit"
+    shutil.copytree(kit.root, copy)
+    path = copy / kit.doc["benchmarks"]["trajectory_files"]["cycle_1kg"]["csv"]
+    lines = path.read_text(encoding="utf-8").splitlines()
+    rows = [line.split(",") for line in lines[1::2]]
+    for k, row in enumerate(rows):
+        row[0] = f"{k * 0.001:.3f}"
+    path.write_text("\n".join([lines[0], *(",".join(r) for r in rows)]) + "\n")
+    findings = {f.check: f for f in check_benchmark(Kit.open(copy))}
+    assert findings["benchmark.max_velocity"].ok and findings["benchmark.acceleration"].ok
+    assert findings["benchmark.dt"].ok
+    assert not findings["benchmark.q_integrates_qd"].ok
+    assert not findings["benchmark.qd_change"].ok
+    # shorter than its segment table: a failed finding, not an IndexError
+    assert not findings["benchmark.tcp_points"].ok
+    original = {f.check: f for f in check_benchmark(kit)}
+    assert original["benchmark.q_integrates_qd"].ok and original["benchmark.qd_change"].ok

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import zipfile
 
 import numpy as np
 import pytest
@@ -133,3 +134,49 @@ def test_each_kind_of_change(rosie_1000, copy):
 def test_missing_kit_is_one_line_error(tmp_path):
     result = CliRunner().invoke(main, ["diff", str(tmp_path / "nope"), str(tmp_path)])
     assert result.exit_code == 2 and "no such kit" in result.output
+
+
+def test_not_a_kit_is_one_line_error(rosie_1000, tmp_path):
+    """A folder or zip without robot.json, a file that is not a zip, a kit with a broken
+    robot.json or STL: one line, exit 2, no traceback (not "everything removed")."""
+    plain = tmp_path / "plain"
+    plain.mkdir()
+    (plain / "notes.txt").write_text("not a kit")
+    no_kit_zip = tmp_path / "plain.zip"
+    with zipfile.ZipFile(no_kit_zip, "w") as archive:
+        archive.writestr("plain/notes.txt", "not a kit")
+    not_zip = tmp_path / "bad.zip"
+    not_zip.write_bytes(b"PK\x03\x04 truncated")
+    broken_json = tmp_path / "broken_json"
+    shutil.copytree(rosie_1000.kit_dir, broken_json)
+    (broken_json / "robot.json").write_text("{")
+    broken_stl = tmp_path / "broken_stl"
+    shutil.copytree(rosie_1000.kit_dir, broken_stl)
+    (broken_stl / "meshes" / "visual" / "link_1.stl").write_bytes(b"solid x")
+    runner = CliRunner()
+    for other, message in (
+        (plain, "not a kit"),
+        (no_kit_zip, "not a kit"),
+        (not_zip, "not a kit zip"),
+        (broken_json, "not valid JSON"),
+        (broken_stl, "not a binary STL"),
+    ):
+        arg_sets = [
+            [str(rosie_1000.kit_dir), str(other)],
+            ["--json", str(other), str(rosie_1000.kit_dir)],
+        ]
+        for args in arg_sets:
+            result = runner.invoke(main, ["diff", *args])
+            assert result.exit_code == 2, (other, result.output)
+            assert result.output.count("\n") == 1 and message in result.output, result.output
+            assert "Traceback" not in result.output
+
+
+def test_zip_of_the_kit_contents_without_a_top_folder(rosie_1000, tmp_path):
+    flat = tmp_path / "flat.zip"
+    with zipfile.ZipFile(flat, "w") as archive:
+        for path in sorted(rosie_1000.kit_dir.rglob("*")):
+            if path.is_file():
+                archive.write(path, path.relative_to(rosie_1000.kit_dir).as_posix())
+    report = diff_kits(rosie_1000.zip_path, flat)
+    assert report.equal, (report.added, report.removed, report.changed)

@@ -69,10 +69,14 @@ def _target(case: dict) -> np.ndarray:
     return T
 
 
-def test_page_snippet_passes_on_the_emitted_file(rosie_1000):
+ARMS = ["rosie_600", "rosie_1000", "rosie_1400"]
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_page_snippet_passes_on_the_emitted_file(kit_factory, name):
     done = subprocess.run(
         [sys.executable, "-c", PAGE_SNIPPET],
-        cwd=rosie_1000.kit_dir,
+        cwd=kit_factory(name).kit_dir,
         capture_output=True,
         text=True,
         timeout=60,
@@ -84,8 +88,10 @@ def test_page_snippet_passes_on_the_emitted_file(rosie_1000):
     assert float(match.group(2)) < float(match.group(3)) <= 1e-6
 
 
-def test_every_solution_is_within_limits_and_reaches_the_target(rosie_1000, cases):
-    kit = Kit.open(rosie_1000.kit_dir)
+@pytest.mark.parametrize("name", ARMS)
+def test_every_solution_is_within_limits_and_reaches_the_target(kit_factory, name):
+    kit = Kit.open(kit_factory(name).kit_dir)
+    cases = json.loads(kit.path("ik_cases.json").read_text(encoding="utf-8"))
     lower = np.array([j["lower"] for j in kit.joints])
     upper = np.array([j["upper"] for j in kit.joints])
     total = 0

@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import ast
 import re
+import shutil
+import xml.etree.ElementTree as ET
 
 import yaml
 from catkin_pkg.package import parse_package_string
 
 from simkit import layout
+from simkit.check import ros_check
+from simkit.check.kit import Kit
 
 
 def test_package_xml_parses_and_validates(rosie_1000):
@@ -81,3 +85,51 @@ def test_rviz_config_shows_robot_model_and_tf(rosie_1000):
     model = next(d for d in manager["Displays"] if d["Class"].endswith("RobotModel"))
     assert model["Description Topic"]["Value"] == "/robot_description"
     assert manager["Global Options"]["Fixed Frame"] == "base_footprint"
+
+
+def test_build_check_finds_a_folder_cmakelists_does_not_install(rosie_1000, tmp_path):
+    kit = tmp_path / rosie_1000.kit_dir.name
+    shutil.copytree(rosie_1000.kit_dir, kit)
+    assert [f.ok for f in ros_check.check_ros(Kit.open(kit)) if f.check == "ros2.cmakelists"] == [
+        True
+    ]
+    (kit / "maps").mkdir()
+    (kit / "maps" / "cell.yaml").write_text("{}\n")
+    (kit / "NOTES.md").write_text("notes\n")
+    (finding,) = [f for f in ros_check.check_ros(Kit.open(kit)) if f.check == "ros2.cmakelists"]
+    assert not finding.ok and "maps/" in finding.detail and "NOTES.md" in finding.detail
+
+
+def test_launch_file_robot_description_rewrites_every_mesh(rosie_1000, tmp_path):
+    """Run the launch file's own robot_description() (not a copy of its logic) on an install
+    prefix laid out as colcon installs the package: share/NAME/ holds what CMakeLists.txt
+    installs. ROS is not installed here, so the ament index lookup is the one stand-in."""
+    kit = rosie_1000.kit_dir
+    text = (kit / layout.DISPLAY_LAUNCH).read_text()
+    tree = ast.parse(text)
+    const = _constants(tree)
+    share = tmp_path / "install" / "share" / const["PACKAGE"]
+    shutil.copytree(kit, share)
+
+    def get_package_share_directory(package: str) -> str:
+        if package != const["PACKAGE"]:
+            raise LookupError(package)
+        return str(share)
+
+    keep = [
+        n
+        for n in tree.body
+        if isinstance(n, ast.Assign)
+        or (isinstance(n, ast.FunctionDef) and n.name == "robot_description")
+        or (isinstance(n, ast.Import) and all(a.name == "os" for a in n.names))
+    ]
+    namespace = {"get_package_share_directory": get_package_share_directory}
+    exec(compile(ast.Module(body=keep, type_ignores=[]), "display.launch.py", "exec"), namespace)
+    description = namespace["robot_description"]()
+    assert "../meshes/" not in description
+    uris = re.findall(r'filename="([^"]+)"', description)
+    assert len(uris) >= 7
+    for uri in uris:
+        assert uri.startswith(f"package://{const['PACKAGE']}/meshes/"), uri
+        assert (share / uri.removeprefix(f"package://{const['PACKAGE']}/")).is_file(), uri
+    ET.fromstring(description)  # still a well-formed URDF

@@ -163,3 +163,51 @@ def test_planning_group_tip_must_be_below_base(tmp_path):
     with pytest.raises(SpecError) as info:
         _resolved(tmp_path, "planning_groups:\n  - {name: arm, base: link_3, tip: link_1}\n")
     assert info.value.field == "planning_groups[0].tip" and info.value.line is not None
+
+
+def test_never_pairs_never_touch_in_fresh_configurations(rosie_1000):
+    """The "Never" pairs on configurations the sampler never saw (another seed, 20,000 of
+    them within the limits), on the MJCF's collision geometry: MuJoCo tests only those
+    pairs (explicit <pair>s, margin 0). A pair the sampler saw touch is the control that
+    the detection works."""
+    mujoco = pytest.importorskip("mujoco")
+    kit = rosie_1000.kit_dir
+    doc = json.loads((kit / "robot.json").read_text())
+    never = [tuple(p) for p in doc["collision_pairs"]["never"]]
+    first = doc["collision_pairs"]["first_contact"]
+    control = tuple(min(first, key=first.get).split())  # the pair the sampler saw touch first
+    assert control not in never and never
+    path = kit / "mjcf" / "rosie_1000.xml"
+    root = ET.parse(path).getroot()
+    compiler = root.find("compiler")
+    compiler.set("meshdir", str((path.parent / compiler.get("meshdir")).resolve()))
+    geoms: dict[str, list[ET.Element]] = {}
+    for body in root.iter("body"):
+        for geom in body.findall("geom"):
+            geom.set("contype", "0")  # only the explicit pairs below collide
+            geom.set("conaffinity", "0")
+            if geom.get("class") == "collision":
+                geoms.setdefault(body.get("name"), []).append(geom)
+    contact = root.find("contact")
+    if contact is None:
+        contact = ET.SubElement(root, "contact")
+    for a, b in [*never, control]:
+        for ga, gb in itertools.product(geoms[a], geoms[b]):
+            ET.SubElement(contact, "pair", geom1=ga.get("name"), geom2=gb.get("name"), margin="0")
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    data = mujoco.MjData(model)
+    joints = doc["joints"]
+    adr = [model.jnt_qposadr[model.joint(j["name"]).id] for j in joints]
+    lower = np.array([j["lower"] for j in joints])
+    upper = np.array([j["upper"] for j in joints])
+    unit = np.random.default_rng(doc["collision_pairs"]["seed"] + 1).random((20_000, len(adr)))
+    touched: dict[tuple[str, str], int] = {}
+    for row in lower + unit * (upper - lower):
+        data.qpos[adr] = row
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        for g1, g2 in data.contact.geom[: data.ncon]:
+            names = sorted(model.body(model.geom_bodyid[g]).name for g in (g1, g2))
+            touched[tuple(names)] = touched.get(tuple(names), 0) + 1
+    assert touched.get(control, 0) > 0  # the detection sees contacts
+    assert not {pair: n for pair, n in touched.items() if pair in never}

@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from simkit import layout
-from simkit.archive import read_zip
 from simkit.errors import SimkitError
 from simkit.fmt import num
 from simkit.stl import from_stl
@@ -89,20 +88,43 @@ class Report:
         return json.dumps(doc, indent=2) + "\n"
 
 
+def _read_zip(path: Path) -> dict[str, bytes]:
+    """Files of a kit zip, keyed by path inside the kit: the top folder (the kit folder, as
+    simkit writes it) is dropped when every entry shares one; a zip of the kit's contents
+    without a top folder is read as it is."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            files = {i.filename: archive.read(i) for i in archive.infolist() if not i.is_dir()}
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+        raise SimkitError(f"{path}: not a kit zip ({exc})") from None
+    tops = {name.partition("/")[0] if "/" in name else None for name in files}
+    if len(tops) == 1 and None not in tops:
+        return {name.partition("/")[2]: data for name, data in files.items()}
+    return files
+
+
 def load_kit(path: Path) -> dict[str, bytes]:
-    """Files of a kit folder or kit zip, keyed by POSIX path inside the kit."""
+    """Files of a kit folder or kit zip, keyed by POSIX path inside the kit. A kit has a
+    robot.json at its top; anything else is refused rather than reported as all removed."""
     if path.is_file():
-        try:
-            return read_zip(path.read_bytes())
-        except Exception as exc:  # zipfile raises several types for a bad file
-            raise SimkitError(f"{path}: not a kit zip ({exc})") from None
-    if not path.is_dir():
+        files = _read_zip(path)
+    elif path.is_dir():
+        files = {
+            p.relative_to(path).as_posix(): p.read_bytes()
+            for p in sorted(path.rglob("*"))
+            if p.is_file() and "__pycache__" not in p.parts
+        }
+    else:
         raise SimkitError(f"{path}: no such kit folder or zip")
-    return {
-        p.relative_to(path).as_posix(): p.read_bytes()
-        for p in sorted(path.rglob("*"))
-        if p.is_file() and "__pycache__" not in p.parts
-    }
+    if layout.ROBOT_JSON not in files:
+        raise SimkitError(f"{path}: not a kit (no {layout.ROBOT_JSON} at its top)")
+    try:
+        json.loads(files[layout.ROBOT_JSON])
+    except ValueError as exc:
+        raise SimkitError(f"{path}: {layout.ROBOT_JSON} is not valid JSON ({exc})") from None
+    return files
 
 
 def _robot_json(files: dict[str, bytes]) -> dict:
@@ -135,8 +157,11 @@ def _entities(
     return out
 
 
-def _mesh_stats(data: bytes) -> dict:
-    mesh = from_stl(data)
+def _mesh_stats(path: str, data: bytes) -> dict:
+    try:
+        mesh = from_stl(data)
+    except (ValueError, IndexError) as exc:
+        raise SimkitError(f"{path}: not a binary STL ({exc})") from None
     tri = mesh.vertices[mesh.faces]
     volume = float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6)
     size = (mesh.vertices.max(axis=0) - mesh.vertices.min(axis=0)).tolist() if len(tri) else []
@@ -148,7 +173,7 @@ def _meshes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
     for path in sorted(set(old) & set(new)):
         if not path.endswith(".stl") or old[path] == new[path]:
             continue
-        a, b = _mesh_stats(old[path]), _mesh_stats(new[path])
+        a, b = _mesh_stats(path, old[path]), _mesh_stats(path, new[path])
         for key, unit in (("volume", "m^3"), ("bbox", "m"), ("triangles", "")):
             if a[key] != b[key]:
                 out.append(Change("mesh", path, "modified", key, a[key], b[key], unit))

@@ -203,28 +203,61 @@ def check_benchmark(kit: Kit) -> list[Finding]:
             LIMIT_SLACK,
         ),
     ]
+    # The columns must describe one motion, or the bounds above prove nothing: over each
+    # 1 ms step, q moves by the trapezoid-rule integral of qd (exact for piecewise-linear qd
+    # up to a kink inside the step: at most amax dt^2 / 4), and qd changes by at most
+    # amax dt (the true acceleration, not only the qdd column, stays within its bound).
+    step_q = np.abs(np.diff(q, axis=0) - (qd[:-1] + qd[1:]) / 2 * dt).max(axis=0)
+    step_qd = np.abs(np.diff(qd, axis=0)).max(axis=0)
+    out += [
+        _at_most(
+            "benchmark.q_integrates_qd",
+            "largest |dq - mean qd dt| / (benchmark acceleration dt^2 / 4) over a step",
+            float((step_q / (amax * dt**2 / 4)).max()),
+            1.0,
+            1e-3,
+        ),
+        _at_most(
+            "benchmark.qd_change",
+            "largest |dqd| / (benchmark acceleration dt) over a step",
+            float((step_qd / (amax * dt)).max()),
+            1.0,
+            1e-6,
+        ),
+    ]
     ends = np.cumsum([0.0, *bench["segment_times"]["cycle_1kg"]])
     rows = np.rint(ends / dt).astype(int)
     points = bench["path"]["tcp_points_base_link_m"]
     expected = [points[name] for name in bench["path"]["sequence"]]
-    out.append(
-        compare(
-            "benchmark.tcp_points",
-            "TCP at the start and the six segment ends",
-            expected,
-            tcp[rows],
-            TCP_TOL,
-            "m",
+    if rows.max() < len(q):
+        out.append(
+            compare(
+                "benchmark.tcp_points",
+                "TCP at the start and the six segment ends",
+                expected,
+                tcp[rows],
+                TCP_TOL,
+                "m",
+            )
         )
-    )
+    else:  # a finding, not an IndexError, for a trajectory shorter than its segments
+        out.append(
+            require(
+                "benchmark.tcp_points",
+                False,
+                f"the trajectory has {len(q)} samples; its segments end at sample {rows.max()}",
+            )
+        )
     offset = np.array([*bench["tcp"]["xyz"], 1.0])
-    fk_tcp = np.array([(kit.fk(row) @ offset)[:3] for row in q[::10]])
+    # every 10th sample and every segment end, so the points above are reached by q itself
+    picked = sorted(set(range(0, len(q), 10)) | {int(r) for r in rows if 0 <= r < len(q)})
+    fk_tcp = np.array([(kit.fk(q[row]) @ offset)[:3] for row in picked])
     out.append(
         compare(
             "benchmark.tcp_fk",
-            "TCP column vs robot.json FK (every 10th sample)",
+            "TCP column vs robot.json FK (every 10th sample and the segment ends)",
             fk_tcp,
-            tcp[::10],
+            tcp[picked],
             1e-8,
             "m",
         )

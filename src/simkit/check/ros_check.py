@@ -8,6 +8,7 @@ Kit page: "launch/ rviz/ package.xml CMakeLists.txt ROS 2 package NAME_descripti
 from __future__ import annotations
 
 import ast
+import re
 import xml.etree.ElementTree as ET
 
 from simkit import layout
@@ -41,6 +42,50 @@ def _package(kit: Kit) -> list[Finding]:
             depends >= NEEDED_EXEC_DEPENDS,
             f"exec_depends include {sorted(NEEDED_EXEC_DEPENDS)}",
         ),
+    ]
+
+
+#: `foreach(VAR a b c)` whose body installs `${VAR}` as a DIRECTORY or FILES, and plain
+#: `install(DIRECTORY|FILES a b c DESTINATION ...)`.
+_LOOP = re.compile(r"foreach\((\w+)\s+([^)]*)\)(.*?)endforeach\(\)", re.S)
+_INSTALL = re.compile(r"install\((DIRECTORY|FILES)\s+([^)]*?)\s+DESTINATION", re.S)
+
+
+def installed_paths(text: str) -> dict[str, set[str]]:
+    """{"DIRECTORY": names, "FILES": names} that a CMakeLists.txt installs."""
+    out: dict[str, set[str]] = {"DIRECTORY": set(), "FILES": set()}
+    for var, items, body in _LOOP.findall(text):
+        for kind, args in _INSTALL.findall(body):
+            if args.split() == [f"${{{var}}}"]:
+                out[kind] |= set(items.split())
+    for kind, args in _INSTALL.findall(_LOOP.sub("", text)):
+        out[kind] |= set(args.split())
+    return out
+
+
+def _cmakelists(kit: Kit) -> list[Finding]:
+    """CMakeLists.txt installs every folder and top-level file of the kit (package.xml and
+    CMakeLists.txt itself aside), so `colcon build` ships all of it."""
+    path = kit.path(layout.CMAKELISTS)
+    if not path.is_file():
+        return [require("ros2.cmakelists", False, f"{layout.CMAKELISTS} is missing")]
+    installed = installed_paths(path.read_text(encoding="utf-8"))
+    own = {layout.PACKAGE_XML, layout.CMAKELISTS}
+    missing = sorted(
+        p.name + ("/" if p.is_dir() else "")
+        for p in kit.root.iterdir()
+        if not p.name.startswith(".") and p.name != "__pycache__"  # a user's, not the kit's
+        if (p.is_dir() and p.name not in installed["DIRECTORY"])
+        or (p.is_file() and p.name not in own and p.name not in installed["FILES"])
+    )
+    return [
+        require(
+            "ros2.cmakelists",
+            not missing,
+            f"{layout.CMAKELISTS} does not install {missing}"
+            if missing
+            else f"{layout.CMAKELISTS} installs every folder and file of the kit",
+        )
     ]
 
 
@@ -129,5 +174,5 @@ def _srdf(kit: Kit) -> list[Finding]:
 
 
 def check_ros(kit: Kit) -> list[Finding]:
-    """package.xml, launch/display.launch.py and the SRDF against the URDF."""
-    return _package(kit) + _launch(kit) + _srdf(kit)
+    """package.xml, CMakeLists.txt, launch/display.launch.py and the SRDF against the URDF."""
+    return _package(kit) + _cmakelists(kit) + _launch(kit) + _srdf(kit)
