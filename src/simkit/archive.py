@@ -23,12 +23,12 @@ def zip_bytes(files: dict[str, bytes], top: str) -> bytes:
 
 
 def read_zip(data: bytes) -> dict[str, bytes]:
-    """Files of a kit zip, keyed by path inside the top folder."""
-    out: dict[str, bytes] = {}
+    """Files of a kit zip, keyed by path inside the kit: the top folder (the kit folder, as
+    `zip_bytes` writes it) is dropped when every entry shares one; a zip of the kit's
+    contents without a top folder is read as it is."""
     with zipfile.ZipFile(io.BytesIO(data)) as archive:
-        for info in archive.infolist():
-            if info.is_dir():
-                continue
-            _, _, inner = info.filename.partition("/")
-            out[inner] = archive.read(info)
-    return out
+        files = {i.filename: archive.read(i) for i in archive.infolist() if not i.is_dir()}
+    tops = {name.partition("/")[0] if "/" in name else None for name in files}
+    if len(tops) == 1 and None not in tops:
+        return {name.partition("/")[2]: data for name, data in files.items()}
+    return files

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from simkit import layout
+from simkit.archive import read_zip
 from simkit.errors import SimkitError
 from simkit.fmt import num
 from simkit.stl import from_stl
@@ -89,20 +90,13 @@ class Report:
 
 
 def _read_zip(path: Path) -> dict[str, bytes]:
-    """Files of a kit zip, keyed by path inside the kit: the top folder (the kit folder, as
-    simkit writes it) is dropped when every entry shares one; a zip of the kit's contents
-    without a top folder is read as it is."""
+    """Files of a kit zip (`archive.read_zip`), or a one-line error for anything else."""
     import zipfile
 
     try:
-        with zipfile.ZipFile(path) as archive:
-            files = {i.filename: archive.read(i) for i in archive.infolist() if not i.is_dir()}
+        return read_zip(path.read_bytes())
     except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
         raise SimkitError(f"{path}: not a kit zip ({exc})") from None
-    tops = {name.partition("/")[0] if "/" in name else None for name in files}
-    if len(tops) == 1 and None not in tops:
-        return {name.partition("/")[2]: data for name, data in files.items()}
-    return files
 
 
 def load_kit(path: Path) -> dict[str, bytes]:

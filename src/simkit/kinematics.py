@@ -84,6 +84,19 @@ def quat_wxyz(rot: np.ndarray) -> tuple[float, float, float, float]:
     return tuple(float(v) for v in arr)  # type: ignore[return-value]
 
 
+def quat_matrix(quat: Sequence[float]) -> np.ndarray:
+    """Rotation matrix of a quaternion (w, x, y, z); normalised first, so readers of float32
+    files (glTF, USD) get an orthonormal matrix."""
+    w, x, y, z = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
 def joint_origin(joint: Joint) -> np.ndarray:
     """T_parent_child of a joint at q = 0."""
     return transform(joint.xyz, rpy_matrix(joint.rpy))

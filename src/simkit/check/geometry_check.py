@@ -8,7 +8,7 @@ import numpy as np
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
 from simkit.check.mujoco_check import random_configs
-from simkit.kinematics import axis_angle, transform
+from simkit.kinematics import axis_angle, quat_matrix, transform
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
 CONVEX_TOL = 1e-6  # m: float32 STL round-off on a face plane
@@ -83,15 +83,10 @@ def check_collision(kit: Kit) -> list[Finding]:
     ]
 
 
-def _quat_matrix(q) -> np.ndarray:
+def _xyzw_matrix(q) -> np.ndarray:
+    """glTF stores quaternions as (x, y, z, w)."""
     x, y, z, w = q
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    return quat_matrix((w, x, y, z))
 
 
 def glb_world(doc: dict, q: dict[str, float]) -> dict[str, np.ndarray]:
@@ -102,7 +97,7 @@ def glb_world(doc: dict, q: dict[str, float]) -> dict[str, np.ndarray]:
     def walk(index: int, parent: np.ndarray) -> None:
         node = doc["nodes"][index]
         local = transform(
-            node.get("translation", (0, 0, 0)), _quat_matrix(node.get("rotation", (0, 0, 0, 1)))
+            node.get("translation", (0, 0, 0)), _xyzw_matrix(node.get("rotation", (0, 0, 0, 1)))
         )
         joint = node.get("extras", {}).get("joint", {})
         value = q.get(joint.get("name", ""), 0.0)

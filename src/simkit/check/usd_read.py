@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from simkit.kinematics import axis_angle
+from simkit.kinematics import axis_angle, quat_matrix
 
 MOVABLE = {"RevoluteJoint": "revolute", "PrismaticJoint": "prismatic"}
 
@@ -33,15 +33,8 @@ class UsdJoint:
 
 def matrix(pos, quat) -> np.ndarray:
     """4x4 column-convention transform from a Gf vector and Gf quaternion."""
-    w, (x, y, z) = quat.GetReal(), quat.GetImaginary()
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    w, x, y, z = w / n, x / n, y / n, z / n
     out = np.eye(4)
-    out[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ]
+    out[:3, :3] = quat_matrix((quat.GetReal(), *quat.GetImaginary()))
     out[:3, 3] = list(pos)
     return out
 
