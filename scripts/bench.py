@@ -98,7 +98,7 @@ def main() -> None:
     args = parser.parse_args()
     targets = args.targets
     if not targets:
-        from simkit.resources import robot_names
+        from simkit.kitio.resources import robot_names
 
         targets = [n for n in robot_names() if n.startswith("rosie_")]
     rows = [bench(t, args.warm, args.jobs) for t in targets]

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import manifold3d as mf
 
-from simkit.solids import to_mesh
-from simkit.stl import to_stl
+from simkit.derive.solids import to_mesh
+from simkit.kitio.stl import to_stl
 
 OUT = Path(__file__).resolve().parents[1] / "tests" / "specs" / "meshes" / "bracket.stl"
 

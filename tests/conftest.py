@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from simkit.build import BuildResult, build
+from simkit.pipeline import BuildResult, build
 
 REPO = Path(__file__).resolve().parents[1]
 SPECS = Path(__file__).resolve().parent / "specs"
@@ -39,7 +39,7 @@ def rosie_1000_published(tmp_path_factory) -> tuple[Path, dict]:
     """(site folder, index) of `simkit publish rosie_1000`: a second, independent build of
     rosie_1000, without the cache, which the reproducibility test compares with `rosie_1000`
     (so a cache hit and a fresh computation must give the same bytes)."""
-    from simkit.cache import Cache
+    from simkit.kitio.cache import Cache
     from simkit.publish import publish
 
     out = tmp_path_factory.mktemp("published") / "sim"

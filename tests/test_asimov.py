@@ -15,12 +15,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from simkit.build import BuildResult
 from simkit.check.kit import Kit
-from simkit.check.legged_check import check_drop, check_stand
+from simkit.check.legged import check_drop, check_stand
 from simkit.errors import SpecError
-from simkit.validate import load_spec, validate
-from simkit.yamlsource import load_yaml
+from simkit.pipeline import BuildResult
+from simkit.spec.load import load_yaml
+from simkit.spec.validate import load_spec, validate
 
 REPO = Path(__file__).resolve().parents[1]
 LEGS = ("left", "right")

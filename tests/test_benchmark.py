@@ -11,9 +11,9 @@ import shutil
 import numpy as np
 import pytest
 
-from simkit import benchmark
 from simkit.check.kit import Kit
-from simkit.check.motion_check import check_benchmark
+from simkit.check.motion import check_benchmark
+from simkit.derive import benchmark
 
 
 @pytest.fixture(scope="module")

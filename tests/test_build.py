@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from simkit.build import build
 from simkit.check import run_checks
 from simkit.errors import CheckFailed
+from simkit.pipeline import build
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -103,8 +103,8 @@ TAMPER = [
 
 @pytest.mark.parametrize(("kind", "old", "new", "check"), TAMPER, ids=[t[3] for t in TAMPER])
 def test_checks_catch_a_tampered_urdf_or_mjcf(rosie_1000, tmp_path, kind, old, new, check):
-    from simkit.check.mujoco_check import check_models, check_parameters
-    from simkit.check.urdf_check import check_urdf
+    from simkit.check.mujoco import check_models, check_parameters
+    from simkit.check.urdf import check_urdf
 
     checks = {"models": check_models, "mjcf_parameters": check_parameters, "urdf": check_urdf}
     assert all(f.ok for f in run_checks(rosie_1000.kit_dir, checks))
@@ -138,7 +138,7 @@ def test_check_writes_nothing_into_the_kit(rosie_1000, tmp_path):
     """`simkit check` reads a kit as it is (it may be read-only or checked twice at once):
     no check writes into it (compiling the URDF in MuJoCo uses a copy elsewhere)."""
     from simkit.check.kit import Kit
-    from simkit.check.mujoco_check import load_urdf_in_mujoco
+    from simkit.check.mujoco import load_urdf_in_mujoco
 
     copy = tmp_path / "kit"
     shutil.copytree(rosie_1000.kit_dir, copy)
@@ -209,7 +209,7 @@ def test_check_on_missing_folder_is_one_line(tmp_path):
 
 
 def test_warm_rebuild_reuses_check_findings_of_identical_kit(tmp_path):
-    from simkit.cache import Cache
+    from simkit.kitio.cache import Cache
 
     spec = REPO / "tests/specs/planar_2r.yaml"
     cold = Cache.at(tmp_path / "cache")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from simkit.cache import ENV_DIR, Cache, default_dir, make_key
+from simkit.kitio.cache import ENV_DIR, Cache, default_dir, make_key
 
 
 def test_key_covers_inputs_step_version_and_every_parameter():
@@ -110,8 +110,8 @@ def test_cli_cache_dir_and_no_cache(tmp_path):
 def test_warm_derive_hits_every_step_and_emits_the_same_bytes(tmp_path):
     """Link solids, collision pieces and the cached robot-level steps come back from the
     cache, and the kit's files are byte-identical to the cold build's."""
-    from simkit.build import model_from_spec
     from simkit.emit import emit_all
+    from simkit.pipeline import model_from_spec
 
     cold = emit_all(model_from_spec("rosie_1000", cache=Cache.at(tmp_path), jobs=1))
     warm_cache = Cache.at(tmp_path)
@@ -123,7 +123,7 @@ def test_warm_derive_hits_every_step_and_emits_the_same_bytes(tmp_path):
     assert warm == cold
     # a warm derive and emit import neither CoACD nor trimesh (issue 3: lazy imports)
     code = (
-        "import sys; from simkit.build import model_from_spec; from simkit.cache import Cache; "
+        "import sys; from simkit.pipeline import model_from_spec; from simkit.kitio.cache import Cache; "
         "from simkit.emit import emit_all; "
         f"emit_all(model_from_spec('rosie_1000', cache=Cache.at({str(tmp_path)!r}))); "
         "print(sorted(m for m in ('coacd', 'trimesh') if m in sys.modules))"

@@ -11,15 +11,16 @@ import manifold3d as mf
 import numpy as np
 import pytest
 
-from simkit import collision, linkwork
-from simkit.build import model_from_spec
-from simkit.cache import Cache
-from simkit.check.geometry_check import _outside
+from simkit.check.geometry import _outside
+from simkit.derive import collision
+from simkit.derive import per_link as linkwork
+from simkit.derive.solids import to_mesh
 from simkit.errors import SpecError
-from simkit.model import Mesh
-from simkit.resources import robot_names
-from simkit.solids import to_mesh
-from simkit.stl import from_stl
+from simkit.kitio.cache import Cache
+from simkit.kitio.resources import robot_names
+from simkit.kitio.stl import from_stl
+from simkit.model.robot import Mesh
+from simkit.pipeline import model_from_spec
 
 MIX = str(Path(__file__).resolve().parent / "specs" / "collision_mix.yaml")
 ROSIES = [name for name in robot_names() if name.startswith("rosie_")]
@@ -87,8 +88,8 @@ def test_rosie_1000_kit_writes_the_pieces_and_their_quality(rosie_1000):
 
 
 def test_convex_needs_a_convex_union():
-    from simkit.resolve import resolve
-    from simkit.validate import load_spec
+    from simkit.model.resolve import resolve
+    from simkit.spec.validate import load_spec
 
     spec, doc = load_spec(Path(MIX), display=MIX)
     hub = resolve(spec, doc.text.encode(), MIX).link("hub")
@@ -98,7 +99,7 @@ def test_convex_needs_a_convex_union():
 
 
 def test_convex_on_a_subtracted_solid_is_a_spec_error(tmp_path):
-    from simkit.validate import load_spec
+    from simkit.spec.validate import load_spec
 
     text = (
         Path(MIX).read_text().replace("  - name: hub\n", "  - name: hub\n    collision: convex\n")

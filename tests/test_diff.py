@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 from simkit.cli import main
 from simkit.diff import diff_kits, to_markdown
-from simkit.stl import from_stl, to_stl
+from simkit.kitio.stl import from_stl, to_stl
 
 
 @pytest.fixture()

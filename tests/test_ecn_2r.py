@@ -18,11 +18,11 @@ import numpy as np
 import pytest
 import yaml
 
-from simkit.check.freefall_check import check_freefall
+from simkit.check.freefall import check_freefall
 from simkit.check.kit import Kit
 from simkit.errors import SpecError
-from simkit.kinematics import rpy_matrix
-from simkit.validate import load_spec
+from simkit.model.kinematics import rpy_matrix
+from simkit.spec.validate import load_spec
 
 REPO = Path(__file__).resolve().parents[1]
 SPEC = (REPO / "robots" / "ecn_2r.yaml").read_text()

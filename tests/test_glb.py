@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simkit.build import model_from_spec
 from simkit.check.kit import Kit
 from simkit.emit import glb
-from simkit.resources import robot_names
+from simkit.kitio.resources import robot_names
+from simkit.pipeline import model_from_spec
 
 SPECS = Path(__file__).resolve().parent / "specs"
 MIX = str(SPECS / "collision_mix.yaml")
@@ -140,7 +140,7 @@ def test_tree_materials_and_positions(kit_factory):
     positions = np.frombuffer(binary, "<f4", accessor["count"] * 3, view["byteOffset"]).reshape(
         -1, 3
     )
-    from simkit.stl import from_stl
+    from simkit.kitio.stl import from_stl
 
     visual = from_stl((kit_dir / "meshes" / "visual" / "bracket.stl").read_bytes()).vertices
     assert {tuple(v) for v in np.float32(visual)} == {tuple(v) for v in positions}

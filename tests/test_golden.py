@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from simkit.build import model_from_spec
 from simkit.emit import docs, mjcf, srdf, urdf
+from simkit.pipeline import model_from_spec
 
 GOLDEN = Path(__file__).resolve().parent / "golden" / "planar_2r"
 SPEC = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"

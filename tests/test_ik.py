@@ -14,9 +14,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simkit import ik, ik_cases
-from simkit.build import model_from_spec
 from simkit.check.kit import Kit
+from simkit.derive import ik_cases
+from simkit.model import ik
+from simkit.pipeline import model_from_spec
 
 # The kit page's ik_cases check snippet, unchanged.
 PAGE_SNIPPET = """

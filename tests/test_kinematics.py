@@ -6,11 +6,11 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from simkit.build import model_from_spec
-from simkit.dynamics import axis_inertia
-from simkit.fmt import num
-from simkit.kinematics import axis_angle, forward, matrix_rpy, quat_wxyz, rpy_matrix
-from simkit.mjcompat import full_mass_matrix
+from mjcompat import full_mass_matrix
+from simkit.kitio.fmt import num
+from simkit.model.dynamics import axis_inertia
+from simkit.model.kinematics import axis_angle, forward, matrix_rpy, quat_wxyz, rpy_matrix
+from simkit.pipeline import model_from_spec
 
 angles = st.floats(min_value=-3.1, max_value=3.1, allow_nan=False)
 ROSIE = model_from_spec("rosie_1000")

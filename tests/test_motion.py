@@ -12,9 +12,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from simkit.build import model_from_spec
 from simkit.emit import motion_files, robot_json
-from simkit.kinematics import axis_angle, quat_wxyz, rpy_matrix, transform
+from simkit.model.kinematics import axis_angle, quat_wxyz, rpy_matrix, transform
+from simkit.pipeline import model_from_spec
 
 STEP = 1e-5  # s, finite-difference time step
 STEPS = 10

@@ -13,9 +13,9 @@ import pytest
 import yaml
 import yourdfpy
 
-from simkit.build import model_from_spec
-from simkit.dynamics import gravity_torques
-from simkit.mjcompat import full_mass_matrix
+from mjcompat import full_mass_matrix
+from simkit.model.dynamics import gravity_torques
+from simkit.pipeline import model_from_spec
 
 # Kit page (000_5f76ade803e16979.txt), table "Robot | Wrist centre | Published reach | tool0 at
 # home | Mass" and "Frames and conventions".

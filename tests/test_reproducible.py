@@ -5,8 +5,8 @@ from __future__ import annotations
 import difflib
 import zipfile
 
-from simkit import layout
-from simkit.archive import FIXED_TIME
+from simkit.kitio import layout
+from simkit.kitio.archive import FIXED_TIME
 
 
 def _tree(root):

@@ -7,8 +7,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from simkit import rnea
-from simkit.build import model_from_spec
+from simkit.model import rnea
+from simkit.pipeline import model_from_spec
 
 
 @pytest.mark.parametrize("name", ["ecn_2r", "rosie_1000"])

@@ -10,9 +10,9 @@ import xml.etree.ElementTree as ET
 import yaml
 from catkin_pkg.package import parse_package_string
 
-from simkit import layout
-from simkit.check import ros_check
+from simkit.check import ros as ros_check
 from simkit.check.kit import Kit
+from simkit.kitio import layout
 
 
 def test_package_xml_parses_and_validates(rosie_1000):

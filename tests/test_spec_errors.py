@@ -12,8 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from simkit.errors import SpecError
-from simkit.validate import load_spec
-from simkit.yamlsource import load_yaml
+from simkit.spec.load import load_yaml
+from simkit.spec.validate import load_spec
 
 REPO = Path(__file__).resolve().parents[1]
 GOOD = (REPO / "robots" / "rosie_1000.yaml").read_text()

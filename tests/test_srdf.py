@@ -15,11 +15,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simkit.build import find_spec
 from simkit.emit import srdf
 from simkit.errors import SpecError
-from simkit.resolve import resolve
-from simkit.validate import load_spec
+from simkit.model.resolve import resolve
+from simkit.pipeline import find_spec
+from simkit.spec.validate import load_spec
 
 
 def _srdf(kit: Path) -> ET.Element:

@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from simkit.build import build, model_from_spec
 from simkit.check.kit import Kit
-from simkit.check.usd_check import check_usd, usd_path
-from simkit.check.usd_read import joints_from_parser, joints_from_schemas, parse_physics
+from simkit.check.readers.usd import joints_from_parser, joints_from_schemas, parse_physics
+from simkit.check.usd import check_usd, usd_path
 from simkit.cli import main
 from simkit.emit import usd
+from simkit.pipeline import build, model_from_spec
 
 SPECS = Path(__file__).resolve().parent / "specs"
 USDA = "usd/rosie_1000.usda"

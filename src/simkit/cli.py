@@ -70,8 +70,8 @@ def build(
     usd_format: str,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
-    from simkit.build import build as run_build
-    from simkit.cache import Cache
+    from simkit.kitio.cache import Cache
+    from simkit.pipeline import build as run_build
 
     cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
 
@@ -127,7 +127,7 @@ def check(kit_dir: Path, verbose: bool) -> None:
 @main.command(name="list")
 def list_robots() -> None:
     """List the robots simkit ships specs for."""
-    from simkit.resources import robot_names
+    from simkit.kitio.resources import robot_names
 
     for name in robot_names():
         out.print(name, markup=False)

@@ -17,11 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit import layout
-from simkit.archive import read_zip
 from simkit.errors import SimkitError
-from simkit.fmt import num
-from simkit.stl import from_stl
+from simkit.kitio import layout
+from simkit.kitio.archive import read_zip
+from simkit.kitio.fmt import num
+from simkit.kitio.stl import from_stl
 
 #: robot.json joint fields compared, with their units (angles of prismatic joints are m).
 JOINT_FIELDS = {

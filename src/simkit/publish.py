@@ -21,12 +21,12 @@ import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from simkit import layout
-from simkit.build import _swap_in, build, find_spec, write_tree
 from simkit.errors import SimkitError
-from simkit.jsonout import dumps
-from simkit.resources import robot_names
-from simkit.validate import load_spec
+from simkit.kitio import layout
+from simkit.kitio.jsonout import dumps
+from simkit.kitio.resources import robot_names
+from simkit.pipeline import _swap_in, build, find_spec, write_tree
+from simkit.spec.validate import load_spec
 
 INDEX_FORMAT = 1
 

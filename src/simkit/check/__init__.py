@@ -9,16 +9,16 @@ from collections.abc import Callable
 from pathlib import Path
 
 from simkit.check.findings import Finding, require
-from simkit.check.freefall_check import check_freefall
-from simkit.check.geometry_check import check_collision, check_glb
+from simkit.check.freefall import check_freefall
+from simkit.check.geometry import check_collision, check_glb
 from simkit.check.kit import Kit
-from simkit.check.legged_check import check_legged
-from simkit.check.motion_check import check_motion
-from simkit.check.mujoco_check import check_hold, check_models, check_parameters
-from simkit.check.published import check_published
-from simkit.check.ros_check import check_ros
-from simkit.check.urdf_check import check_urdf
-from simkit.check.usd_check import check_usd
+from simkit.check.legged import check_legged
+from simkit.check.motion import check_motion
+from simkit.check.mujoco import check_hold, check_models, check_parameters
+from simkit.check.published_numbers import check_published
+from simkit.check.ros import check_ros
+from simkit.check.urdf import check_urdf
+from simkit.check.usd import check_usd
 
 Check = Callable[[Kit], list[Finding]]
 
@@ -64,7 +64,7 @@ def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache) -> list[Fin
     """
     from dataclasses import asdict
 
-    from simkit.cache import code_digest, decode_json, encode_json, make_key
+    from simkit.kitio.cache import code_digest, decode_json, encode_json, make_key
 
     inputs = [part for path in sorted(files) for part in (path.encode("utf-8"), files[path])]
     key = make_key("checks", 1, inputs, {"code": code_digest()}, CHECK_LIBRARIES)

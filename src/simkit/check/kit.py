@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from simkit.errors import SimkitError
-from simkit.kinematics import axis_angle, rpy_matrix, transform
+from simkit.model.kinematics import axis_angle, rpy_matrix, transform
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ import mujoco
 import numpy as np
 
 from simkit.check.findings import Finding, compare, require
-from simkit.check.usd_read import matrix
+from simkit.check.readers.usd import matrix
 
 
 def collision_findings(parsed: dict, mj, links: dict[str, str]) -> list[Finding]:

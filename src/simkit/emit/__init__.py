@@ -10,6 +10,7 @@ from collections.abc import Callable
 from simkit.emit import (
     docs,
     examples,
+    freefall_files,
     glb,
     meshes,
     mjcf,
@@ -21,9 +22,8 @@ from simkit.emit import (
     srdf,
     urdf,
     usd,
-    validation,
 )
-from simkit.model import Robot
+from simkit.model.robot import Robot
 
 Emitter = Callable[[Robot], dict[str, bytes]]
 
@@ -41,7 +41,7 @@ EMITTERS: dict[str, Emitter] = {
     "motion_files": motion_files.emit,
     "glb": glb.emit,
     "ros2_control": ros2_control.emit,
-    "validation": validation.emit,
+    "freefall_files": freefall_files.emit,
 }
 
 

@@ -8,12 +8,12 @@ from functools import cache
 import jinja2
 import numpy as np
 
-from simkit import layout
 from simkit.emit import mjcf_world
-from simkit.fmt import num
-from simkit.kinematics import chain, quat_wxyz, rpy_matrix
-from simkit.model import Robot
-from simkit.resources import data_dir
+from simkit.kitio import layout
+from simkit.kitio.fmt import num
+from simkit.kitio.resources import data_dir
+from simkit.model.kinematics import chain, quat_wxyz, rpy_matrix
+from simkit.model.robot import Robot
 
 
 @cache

@@ -7,11 +7,11 @@ examples/fk_ik.py comes from the motion-data emitter.
 
 from __future__ import annotations
 
-from simkit import layout
 from simkit.emit import mjcf_world
 from simkit.emit.docs import environment
-from simkit.fmt import num
-from simkit.model import Robot
+from simkit.kitio import layout
+from simkit.kitio.fmt import num
+from simkit.model.robot import Robot
 
 #: The pose the demos drive to: the first of these the spec names, else all zeros.
 DEMO_POSES = ("work", "stretched", "home")

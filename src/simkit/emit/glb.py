@@ -18,10 +18,11 @@ import struct
 
 import numpy as np
 
-from simkit import __version__, layout
-from simkit.fmt import ZERO_BELOW, rounded
-from simkit.kinematics import quat_wxyz, rpy_matrix
-from simkit.model import Joint, Robot
+from simkit import __version__
+from simkit.kitio import layout
+from simkit.kitio.fmt import ZERO_BELOW, rounded
+from simkit.model.kinematics import quat_wxyz, rpy_matrix
+from simkit.model.robot import Joint, Robot
 
 #: Z-up to Y-up: -90 degrees about x, as (x, y, z, w).
 Y_UP = (-np.sqrt(0.5), 0.0, 0.0, np.sqrt(0.5))

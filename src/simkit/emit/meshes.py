@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from simkit import layout
-from simkit.model import Robot
-from simkit.stl import to_stl
+from simkit.kitio import layout
+from simkit.kitio.stl import to_stl
+from simkit.model.robot import Robot
 
 
 def emit(robot: Robot) -> dict[str, bytes]:

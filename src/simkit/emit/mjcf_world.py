@@ -13,9 +13,9 @@ import xml.etree.ElementTree as ET
 
 from pydantic import BaseModel
 
-from simkit.fmt import num, vec
-from simkit.model import Joint, Robot
-from simkit.xmlwriter import sub
+from simkit.kitio.fmt import num, vec
+from simkit.kitio.xmlwriter import sub
+from simkit.model.robot import Joint, Robot
 
 
 def attrs_of(obj: BaseModel | None, exclude: tuple[str, ...] = ()) -> dict[str, str]:

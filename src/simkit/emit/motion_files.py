@@ -8,11 +8,11 @@ cases".
 
 from __future__ import annotations
 
-from simkit import layout
 from simkit.emit.docs import environment
-from simkit.fmt import num
-from simkit.jsonout import dumps
-from simkit.model import Robot
+from simkit.kitio import layout
+from simkit.kitio.fmt import num
+from simkit.kitio.jsonout import dumps
+from simkit.model.robot import Robot
 
 FK_IK = "fk_ik.py"
 

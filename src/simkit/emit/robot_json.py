@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 from importlib import metadata
 
-from simkit import __version__, inertia_decision, layout
+from simkit import __version__
+from simkit.derive import inertia_decision
+from simkit.derive.solids import CIRCULAR_SEGMENTS
 from simkit.emit import mjcf_world
-from simkit.jsonout import dumps
-from simkit.model import Joint, Link, Robot
-from simkit.solids import CIRCULAR_SEGMENTS
+from simkit.kitio import layout
+from simkit.kitio.jsonout import dumps
+from simkit.model.robot import Joint, Link, Robot
 
 LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core")
 

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit import __version__, layout
+from simkit import __version__
 from simkit.emit.docs import environment
-from simkit.fmt import num
-from simkit.kinematics import forward
-from simkit.model import Robot
+from simkit.kitio import layout
+from simkit.kitio.fmt import num
+from simkit.model.kinematics import forward
+from simkit.model.robot import Robot
 
 #: Kit folders CMakeLists.txt installs when they exist; listed generously so folders that
 #: other emitters or tools add (config/ for ros2_control, ...) are installed too.

@@ -20,11 +20,11 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 
-from simkit import layout
 from simkit.emit.docs import environment
-from simkit.fmt import num
-from simkit.model import Joint, Robot
-from simkit.xmlwriter import sub
+from simkit.kitio import layout
+from simkit.kitio.fmt import num
+from simkit.kitio.xmlwriter import sub
+from simkit.model.robot import Joint, Robot
 
 #: ROS 1 hardware interface names of the URDF transmission spec, per command interface.
 HARDWARE_INTERFACES = {
@@ -147,7 +147,7 @@ def exec_depends(robot: Robot) -> list[str]:
 def derive_ros2_control(robot: Robot) -> Robot:
     """Derive step: the extra ROS 2 packages the package emitter (emit/ros2.py) must depend
     on, and robot.json's `ros2_control` entry (files, controllers, gains, estimates)."""
-    from simkit.derive import with_json  # derive imports this module
+    from simkit.derive.steps import with_json  # derive imports this module
 
     rc = robot.ros2_control
     if rc is None:

@@ -1,0 +1,170 @@
+"""Checks of the written collision pieces and GLB (issue 3), with numpy only so a warm build
+stays fast: pieces per link, convexity, cover of the visual mesh, and GLB FK vs robot.json."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simkit.check.findings import Finding, compare, require
+from simkit.check.kit import Kit
+from simkit.check.mujoco import random_configs
+from simkit.model.kinematics import axis_angle, quat_matrix, transform
+
+MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
+CONVEX_TOL = 1e-6  # m: float32 STL round-off on a face plane
+COVER_TOL = 1e-5  # m: a visual vertex may sit this far outside the pieces (float32 files)
+GLB_FK_TOL = 1e-6  # m and rotation-matrix entries: 10 significant digits in the GLB JSON
+
+
+def _outside(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """How far each point lies outside the convex mesh's face planes (<= 0: inside)."""
+    tri = vertices[faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(n, axis=1)
+    keep = length > 1e-12
+    n = n[keep] / length[keep, None]
+    d = np.einsum("ij,ij->i", n, tri[keep, 0])
+    return (points @ n.T - d).max(axis=1)
+
+
+def check_collision(kit: Kit) -> list[Finding]:
+    """Every link: at most ten pieces, each convex, together covering the visual mesh's
+    vertices; robot.json's `geometry` piece counts match the files."""
+    from simkit.kitio.stl import from_stl
+
+    most, worst_convex, worst_cover, mismatched = 0, 0.0, 0.0, []
+    report = {
+        g["name"]: g.get("collision") or {} for g in kit.doc.get("geometry", {}).get("links", [])
+    }
+    for link in kit.doc["links"]:
+        paths = link["mesh"]["collision"]
+        if not paths:
+            continue
+        most = max(most, len(paths))
+        if report.get(link["name"], {}).get("pieces") != len(paths):
+            mismatched.append(link["name"])
+        pieces = [from_stl(kit.path(p).read_bytes()) for p in paths]
+        for piece in pieces:
+            worst_convex = max(
+                worst_convex, float(_outside(piece.vertices, piece.vertices, piece.faces).max())
+            )
+        if link["mesh"]["visual"]:
+            visual = from_stl(kit.path(link["mesh"]["visual"]).read_bytes()).vertices
+            depth = np.min([_outside(visual, p.vertices, p.faces) for p in pieces], axis=0)
+            worst_cover = max(worst_cover, float(depth.max()))
+    return [
+        require(
+            "collision.pieces",
+            most <= MAX_PIECES,
+            f"at most {MAX_PIECES} convex pieces per link (most: {most})",
+        ),
+        compare(
+            "collision.convex",
+            "largest distance of a piece's vertex outside its own face planes",
+            0.0,
+            worst_convex,
+            CONVEX_TOL,
+            "m",
+        ),
+        compare(
+            "collision.cover",
+            "largest distance of a visual vertex outside every piece",
+            0.0,
+            worst_cover,
+            COVER_TOL,
+            "m",
+        ),
+        require(
+            "collision.report",
+            not mismatched,
+            "robot.json geometry pieces match the files"
+            + (f" except {mismatched}" if mismatched else ""),
+        ),
+    ]
+
+
+def _xyzw_matrix(q) -> np.ndarray:
+    """glTF stores quaternions as (x, y, z, w)."""
+    x, y, z, w = q
+    return quat_matrix((w, x, y, z))
+
+
+def glb_world(doc: dict, q: dict[str, float]) -> dict[str, np.ndarray]:
+    """World pose of every named GLB node with joint values `q` (name -> rad or m) applied
+    about the axis in each node's extras, as the kit page's "GLB" section says to."""
+    out: dict[str, np.ndarray] = {}
+
+    def walk(index: int, parent: np.ndarray) -> None:
+        node = doc["nodes"][index]
+        local = transform(
+            node.get("translation", (0, 0, 0)), _xyzw_matrix(node.get("rotation", (0, 0, 0, 1)))
+        )
+        joint = node.get("extras", {}).get("joint", {})
+        value = q.get(joint.get("name", ""), 0.0)
+        if joint.get("type") in ("revolute", "continuous"):
+            local = local @ transform((0, 0, 0), axis_angle(joint["axis"], value))
+        elif joint.get("type") == "prismatic":
+            local = local @ transform(np.asarray(joint["axis"]) * value)
+        world = parent @ local
+        out[node.get("name", str(index))] = world
+        for child in node.get("children", []):
+            walk(child, world)
+
+    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        walk(root, np.eye(4))
+    return out
+
+
+def check_glb(kit: Kit) -> list[Finding]:
+    """The GLB parses, has a node per link, and its nodes rotated by seeded random joint
+    values put the tool frame where robot.json's FK does."""
+    from simkit.emit.glb import read_glb
+
+    rel = kit.doc.get("files", {}).get("glb", f"glb/{kit.name}.glb")
+    path = kit.path(rel)
+    if not path.is_file():
+        return [require("glb.file", False, f"{rel} is missing")]
+    try:
+        doc, _binary = read_glb(path.read_bytes())
+    except (ValueError, KeyError) as exc:
+        return [require("glb.file", False, f"{rel}: {exc}")]
+    names = {node.get("name") for node in doc["nodes"]}
+    missing = [link["name"] for link in kit.doc["links"] if link["name"] not in names]
+    findings = [
+        require(
+            "glb.nodes",
+            not missing,
+            "a GLB node per link" + (f"; missing {missing}" if missing else ""),
+        )
+    ]
+    tool = kit.doc.get("tool_frame")
+    if tool and tool in names and kit.joints:
+        joint_names = [j["name"] for j in kit.joints]
+        errors, rot_errors = [], []
+        for q in random_configs(kit, 10, seed=2):
+            world = glb_world(doc, dict(zip(joint_names, q, strict=True)))
+            pose = np.linalg.inv(world[kit.base_frame]) @ world[tool]
+            ref = kit.fk(q)
+            errors.append(pose[:3, 3] - ref[:3, 3])
+            rot_errors.append(pose[:3, :3] - ref[:3, :3])
+        findings.append(
+            compare(
+                "glb.fk",
+                f"{tool} from GLB nodes at 10 random configurations vs robot.json FK",
+                np.zeros((len(errors), 3)),
+                errors,
+                GLB_FK_TOL,
+                "m",
+            )
+        )
+        findings.append(
+            compare(
+                "glb.fk.rotation",
+                f"{tool} rotation, GLB vs robot.json",
+                np.zeros((len(rot_errors), 3, 3)),
+                rot_errors,
+                GLB_FK_TOL,
+                "",
+            )
+        )
+    return findings

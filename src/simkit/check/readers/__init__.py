@@ -1,0 +1,1 @@
+"""Independent readers for the kit's binary formats (USD, GLB)."""

@@ -1,0 +1,382 @@
+"""Check the written USD: schema validation, UsdPhysics' own parser, and agreement with the MJCF
+loaded in MuJoCo (masses, CoM, inertia, joint frames, axes, limits, drives, colliders and the
+tool pose at random configurations composed from the USD joints)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from simkit.check.findings import Finding, compare, require
+from simkit.check.kit import Kit
+from simkit.check.mujoco import _body_pose, _site_or_body_pose, load_control_mjcf
+from simkit.check.readers.usd import (
+    UsdJoint,
+    UsdKinematics,
+    joints_from_parser,
+    joints_from_schemas,
+    matrix,
+    parse_physics,
+    validate,
+)
+from simkit.check.usd_collision import collision_findings
+from simkit.kitio import layout
+
+N_RANDOM = 25
+SEED = 1
+#: USD stores masses, inertia, joint frames and drive gains as 32-bit floats (about 7
+#: significant digits): relative tolerance for values compared one by one.
+FLOAT32_REL = 1e-6
+#: Tool pose through 6+ float32 joint frames: metres, and rotation-matrix entries.
+FK_TOL_M = 1e-6
+FK_TOL_ROT = 1e-6
+
+
+def usd_path(kit: Kit) -> Path | None:
+    """The kit's USD file: robot.json `files.usd` if given, else `usd/NAME.usda` or `.usdc`."""
+    named = kit.doc.get("files", {}).get("usd")
+    for rel in ([named] if named else []) + [layout.usd(kit.name), layout.usd(kit.name, True)]:
+        if kit.path(rel).is_file():
+            return kit.path(rel)
+    return None
+
+
+def _tol(values) -> float:
+    """FLOAT32_REL of the largest magnitude compared (float32 storage in USD)."""
+    arr = np.abs(np.asarray(values, dtype=float))
+    return FLOAT32_REL * max(float(arr.max()) if arr.size else 0.0, 1e-9)
+
+
+def _mj_tensor(mj: mujoco.MjModel, body: int) -> np.ndarray:
+    rot = np.zeros(9)
+    mujoco.mju_quat2Mat(rot, mj.body_iquat[body])
+    rot = rot.reshape(3, 3)
+    return rot @ np.diag(mj.body_inertia[body]) @ rot.T
+
+
+def _mass_findings(stage, mj, links: dict[str, str]) -> list[Finding]:
+    """Per-link MassAPI (inertia rebuilt from diagonalInertia and principalAxes) vs MJCF."""
+    from pxr import UsdPhysics
+
+    exp: dict[str, list] = {"mass": [], "com": [], "inertia": []}
+    act: dict[str, list] = {"mass": [], "com": [], "inertia": []}
+    for name, path in links.items():
+        api = UsdPhysics.MassAPI(stage.GetPrimAtPath(path))
+        body = mj.body(name).id
+        exp["mass"].append(mj.body_mass[body])
+        exp["com"].append(mj.body_ipos[body])
+        exp["inertia"].append(_mj_tensor(mj, body))
+        act["mass"].append(api.GetMassAttr().Get())
+        act["com"].append(list(api.GetCenterOfMassAttr().Get()))
+        rot = matrix((0, 0, 0), api.GetPrincipalAxesAttr().Get())[:3, :3]
+        act["inertia"].append(rot @ np.diag(list(api.GetDiagonalInertiaAttr().Get())) @ rot.T)
+    return [
+        compare(
+            "usd.mass",
+            "per-link MassAPI mass vs MJCF",
+            exp["mass"],
+            act["mass"],
+            _tol(exp["mass"]),
+            "kg",
+        ),
+        compare(
+            "usd.com",
+            "per-link MassAPI centerOfMass vs MJCF (link frame)",
+            exp["com"],
+            act["com"],
+            max(_tol(exp["com"]), 1e-7),
+            "m",
+        ),
+        compare(
+            "usd.inertia",
+            "per-link inertia tensor from diagonalInertia and principalAxes vs MJCF (link axes)",
+            exp["inertia"],
+            act["inertia"],
+            _tol(exp["inertia"]),
+            "kg m^2",
+        ),
+    ]
+
+
+def _mj_local(mj, body: int) -> np.ndarray:
+    """T_parent_body of an MJCF body (its pos/quat)."""
+    out, rot = np.eye(4), np.zeros(9)
+    mujoco.mju_quat2Mat(rot, mj.body_quat[body])
+    out[:3, :3], out[:3, 3] = rot.reshape(3, 3), mj.body_pos[body]
+    return out
+
+
+def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str]) -> list[Finding]:
+    """Every USD joint joins the MJCF parent and child bodies at the MJCF body frame; movable
+    joints have the MJCF axis, limits and servo. `names`: USD path -> link name."""
+    from simkit.emit.usd import prim_name
+
+    wrong, frames_exp, frames_act = [], [], []
+    for j in joints:
+        child = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_BODY, names.get(j.body1, "?"))
+        parent = names.get(j.body0, "world")
+        if child < 0 or mj.body(int(mj.body_parentid[child])).name != parent:
+            wrong.append(j.path)
+        elif parent != "world":  # a joint from the world: the FK checks its frame
+            frames_exp.append(_mj_local(mj, child))
+            frames_act.append(j.pose0 @ np.linalg.inv(j.pose1))
+    by_name = {j.path.rsplit("/", 1)[-1]: j for j in joints}
+    missing = [d["name"] for d in kit.joints if prim_name(d["name"]) not in by_name]
+    findings = [
+        require(
+            "usd.joint_bodies",
+            not wrong and not missing,
+            f"every joint joins the MJCF parent and child (wrong: {wrong}; missing: {missing})",
+        ),
+        compare(
+            "usd.joint_frames",
+            "joint localPose0 * inv(localPose1) vs MJCF body pos/quat",
+            frames_exp,
+            frames_act,
+            2e-7,
+            "m or 1",
+        ),
+    ]
+    axes_exp, axes_act, lim_exp, lim_act, drv_exp, drv_act, odd = [], [], [], [], [], [], []
+    actuated = {
+        int(mj.actuator_trnid[a, 0]): a
+        for a in range(mj.nu)
+        if mj.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
+    }
+    for doc in kit.joints:
+        usd = by_name.get(prim_name(doc["name"]))
+        if usd is None:
+            continue
+        jid = mj.joint(doc["name"]).id
+        axes_exp.append(np.concatenate([mj.jnt_axis[jid], mj.jnt_pos[jid]]))
+        axes_act.append(np.concatenate([usd.pose1[:3, :3] @ usd.axis, usd.pose1[:3, 3]]))
+        act = actuated.get(jid)
+        dof, qadr = int(mj.jnt_dofadr[jid]), int(mj.jnt_qposadr[jid])
+        # a joint without a servo but with MJCF stiffness or damping is a passive spring-damper:
+        # a force drive aimed at springref (qpos_spring) with no force limit
+        spring = act is None and bool(mj.jnt_stiffness[jid] or mj.dof_damping[dof])
+        if (
+            bool(mj.jnt_limited[jid]) != (usd.limit is not None)
+            or (act is None and not spring) != (usd.drive is None)
+            or (spring and usd.drive is not None and math.isfinite(usd.drive[2]))
+        ):
+            odd.append(doc["name"])
+            continue
+        unit = math.radians if usd.kind == "revolute" else float  # USD: degrees
+        if usd.limit is not None:
+            lim_exp.append(mj.jnt_range[jid])
+            lim_act.append([unit(v) for v in usd.limit])
+        if usd.drive is not None:
+            per = 180.0 / math.pi if usd.kind == "revolute" else 1.0  # USD: gains per degree
+            if act is not None:
+                gains = [mj.actuator_gainprm[act, 0], -mj.actuator_biasprm[act, 2]]
+                max_force, target = mj.actuator_forcerange[act, 1], 0.0
+            else:
+                gains = [mj.jnt_stiffness[jid], mj.dof_damping[dof]]
+                max_force, target = math.inf, mj.qpos_spring[qadr]  # no limit: not compared
+            drv_exp.append([*gains, max_force, target])
+            drv_act.append(
+                [usd.drive[0] * per, usd.drive[1] * per, usd.drive[2], unit(usd.drive[3])]
+            )
+    findings += [
+        require(
+            "usd.limits_drives",
+            not odd,
+            f"limits and drives where the MJCF has a range, a servo or a passive spring-damper "
+            f"(differ: {odd})",
+        ),
+        compare(
+            "usd.axes",
+            "joint axis and anchor in the child frame vs MJCF",
+            axes_exp,
+            axes_act,
+            2e-7,
+            "1 or m",
+        ),
+        compare(
+            "usd.limits",
+            "joint limits (USD degrees) vs MJCF range",
+            lim_exp,
+            lim_act,
+            1e-5 * max(1.0, float(np.abs(lim_exp).max(initial=0))),
+            "rad or m",
+        ),
+    ]
+    for i, (what, unit) in enumerate(
+        (
+            ("stiffness", "N m/rad"),
+            ("damping", "N m s/rad"),
+            ("maxForce", "N m"),
+            ("targetPosition", "rad"),
+        )
+    ):
+        rows = [(e[i], a[i]) for e, a in zip(drv_exp, drv_act, strict=True) if math.isfinite(e[i])]
+        exp = [e for e, _ in rows]
+        findings.append(
+            compare(
+                f"usd.drive.{what}",
+                f"DriveAPI {what} vs MJCF servo or passive spring-damper",
+                exp,
+                [a for _, a in rows],
+                max(_tol(exp), 1e-9),
+                unit,
+            )
+        )
+    return findings
+
+
+def _fk_findings(kit: Kit, mj, kin: UsdKinematics, paths: dict[str, str]) -> list[Finding]:
+    """T_base_tool and T_base_link of every link, composed from the USD joints, vs MuJoCo at
+    q = 0 and seeded random configurations; and the authored Xforms vs the joints at q = 0."""
+    from simkit.emit.usd import prim_name
+
+    tool, base = kit.doc.get("tool_frame"), kit.base_frame
+    links = [link["name"] for link in kit.doc["links"]]
+    targets = links + ([tool] if tool and tool in paths else [])
+    joints = [j for j in kit.joints if j["type"] in ("revolute", "continuous", "prismatic")]
+    rng = np.random.default_rng(SEED)
+    lower = [j["lower"] if j["lower"] is not None else -np.pi for j in joints]
+    upper = [j["upper"] if j["upper"] is not None else np.pi for j in joints]
+    configs = np.vstack([np.zeros(len(joints)), rng.uniform(lower, upper, (N_RANDOM, len(joints)))])
+    data = mujoco.MjData(mj)
+    qadr = [int(mj.jnt_qposadr[mj.joint(j["name"]).id]) for j in joints]
+    exp, act = [], []
+    for q in configs:
+        data.qpos[qadr] = q
+        mujoco.mj_kinematics(mj, data)
+        inv = np.linalg.inv(_body_pose(mj, data, base))
+        exp.append([inv @ _site_or_body_pose(mj, data, t) for t in targets])
+        poses = kin.poses({prim_name(j["name"]): v for j, v in zip(joints, q, strict=True)})
+        inv = np.linalg.inv(kin.pose(poses, paths[base]))
+        act.append([inv @ kin.pose(poses, paths[t]) for t in targets])
+    exp, act = np.array(exp), np.array(act)
+    rest = kin.poses({})
+    label = f"in {base} at q = 0 and {N_RANDOM} random configurations, from the USD joints"
+    findings = [
+        compare(
+            "usd.fk.links",
+            f"every link pose {label}",
+            exp[:, : len(links), :3],
+            act[:, : len(links), :3],
+            FK_TOL_M,
+            "m or 1",
+        ),
+        compare(
+            "usd.xforms",
+            "authored link Xforms vs the joints composed at q = 0",
+            [kin.world[paths[n]] for n in links],
+            [rest[paths[n]] for n in links],
+            1e-6,
+            "m or 1",
+        ),
+    ]
+    if len(targets) > len(links):
+        findings += [
+            compare(
+                "usd.fk",
+                f"{tool} position {label}",
+                exp[:, -1, :3, 3],
+                act[:, -1, :3, 3],
+                FK_TOL_M,
+                "m",
+            ),
+            compare(
+                "usd.fk.rotation",
+                f"{tool} rotation {label}",
+                exp[:, -1, :3, :3],
+                act[:, -1, :3, :3],
+                FK_TOL_ROT,
+                "",
+            ),
+        ]
+    return findings
+
+
+def check_usd(kit: Kit) -> list[Finding]:
+    """Validate the USD, parse its physics, and compare it with the MJCF in MuJoCo."""
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    from simkit.emit.usd import prim_name
+
+    path = usd_path(kit)
+    if path is None:
+        return [require("usd.present", False, f"no {layout.usd(kit.name)} (or .usdc) in the kit")]
+    rel = path.relative_to(kit.root).as_posix()
+    try:
+        stage = Usd.Stage.Open(str(path))
+    except Exception as exc:  # pxr raises Tf.ErrorException with the parser's message
+        return [require("usd.open", False, f"{rel}: {exc}")]
+    errors, warns = validate(stage)
+    findings = [
+        require(
+            "usd.validate",
+            not errors,
+            f"{rel}: usd-core validators found "
+            f"{len(errors)} error(s), {warns} warning(s){': ' if errors else ''}"
+            f"{'; '.join(errors[:3])}",
+        )
+    ]
+    top = stage.GetDefaultPrim()
+    meta = (
+        UsdGeom.GetStageUpAxis(stage),
+        UsdGeom.GetStageMetersPerUnit(stage),
+        UsdPhysics.GetStageKilogramsPerUnit(stage),
+    )
+    findings.append(
+        require(
+            "usd.stage",
+            bool(top) and meta == ("Z", 1.0, 1.0),
+            f"defaultPrim {top.GetPath() if top else None}, upAxis, metersPerUnit, "
+            f"kilogramsPerUnit {meta} (Z, 1, 1)",
+        )
+    )
+    if not top:
+        return findings
+    root = str(top.GetPath())
+    links = {link["name"]: f"{root}/{prim_name(link['name'])}" for link in kit.doc["links"]}
+    missing = [
+        n for n, p in links.items() if not stage.GetPrimAtPath(p).HasAPI(UsdPhysics.RigidBodyAPI)
+    ]
+    findings.append(
+        require("usd.bodies", not missing, f"a rigid body per link (missing {missing})")
+    )
+    if missing:
+        return findings
+    parsed = parse_physics(stage)
+    if parsed is not None:
+        joints = joints_from_parser(parsed)
+        arts = parsed.get(UsdPhysics.ObjectType.Articulation, ([], []))[1]
+        bodies = {str(b) for a in arts for b in a.articulatedBodies}
+        findings.append(
+            require(
+                "usd.articulation",
+                len(arts) == 1 and set(links.values()) <= bodies,
+                f"UsdPhysics parser: {len(arts)} articulation(s) holding every link",
+            )
+        )
+    else:
+        joints = joints_from_schemas(stage)
+    mj = load_control_mjcf(kit)  # the servos the USD drives mirror
+    findings += _mass_findings(stage, mj, links)
+    findings += _joint_findings(mj, kit, joints, {p: n for n, p in links.items()})
+    if parsed is not None:
+        findings += collision_findings(parsed, mj, links)
+    xforms: dict[str, str] = {}
+    for prim in Usd.PrimRange(top):
+        if prim.IsA(UsdGeom.Xform):
+            xforms.setdefault(prim.GetName(), str(prim.GetPath()))
+    paths = {
+        name: xforms[prim_name(name)]
+        for name in kit.doc.get("frames", {})
+        if prim_name(name) in xforms
+    }
+    paths.update(links)
+    paths.update({n: root for n, f in kit.doc.get("frames", {}).items() if "parent" not in f})
+    try:
+        findings += _fk_findings(kit, mj, UsdKinematics(stage, joints), paths)
+    except (ValueError, KeyError) as exc:  # joints that do not form a tree, unknown bodies
+        findings.append(require("usd.fk", False, f"cannot compose the USD joints: {exc}"))
+    return findings

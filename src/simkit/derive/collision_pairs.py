@@ -1,0 +1,209 @@
+"""Collision pairs for the SRDF: adjacent links, and links that never touch.
+
+Follows what MoveIt Setup Assistant does (moveit_setup_srdf_plugins, compute_default_collisions):
+links joined by a joint are "Adjacent" (a link without collision geometry joins its neighbours
+to each other), and a pair that is never in contact over many random configurations within
+the joint limits is "Never". The kit page ("Simulation parameters") keeps MuJoCo's own rule
+(adjacent pairs only); this list is only for planners.
+
+Sampling runs MuJoCo's collision detection on a model built from each link's collision
+geometry as the URDF gives it: the spec's primitives, else the convex pieces, else the visual
+solid (whose convex hull MuJoCo collides, which can only add contacts, never hide one).
+The configurations are drawn from a seeded generator and can be regenerated from robot.json
+(`sample_unit` with the recorded seed and count, scaled to each joint's limits).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import replace
+
+import numpy as np
+
+from simkit.model.kinematics import quat_wxyz, rpy_matrix
+from simkit.model.robot import Link, Robot, Shape
+
+SAMPLES = 10_000
+SAMPLED_TYPES = ("revolute", "continuous", "prismatic")
+METHOD = (
+    "MoveIt Setup Assistant's rule: 'Adjacent' = links joined by a joint (links without "
+    "collision geometry join their neighbours); 'Never' = no contact between the links' "
+    "collision geometry (MuJoCo collision detection, margin 0) in any of `samples` "
+    "configurations q = lower + u * (upper - lower), u = numpy.random.default_rng(seed)"
+    ".random((samples, len(joints))), joints in robot.json order (continuous joints over "
+    "-pi..pi)"
+)
+
+
+def has_geometry(link: Link) -> bool:
+    return bool(link.collision_primitives or link.collision or link.solid is not None)
+
+
+def adjacent_pairs(robot: Robot) -> list[tuple[str, str]]:
+    """Pairs of links with collision geometry joined by a joint, or by a chain of links and
+    frames without geometry (MoveIt Setup Assistant's connection graph), sorted."""
+    neighbours: dict[str, set[str]] = {}
+    for joint in robot.joints:
+        neighbours.setdefault(joint.parent, set()).add(joint.child)
+        neighbours.setdefault(joint.child, set()).add(joint.parent)
+    solid = {link.name for link in robot.links if has_geometry(link)}
+    for node in sorted(set(neighbours) - solid):  # contract geometry-less nodes
+        around = neighbours.pop(node)
+        for other in around:
+            neighbours[other].discard(node)
+        for a, b in itertools.combinations(sorted(around), 2):
+            neighbours[a].add(b)
+            neighbours[b].add(a)
+    pairs = {tuple(sorted((a, b))) for a in solid for b in neighbours.get(a, ()) if b in solid}
+    return sorted(pairs)  # type: ignore[arg-type]
+
+
+def sampled_joints(robot: Robot) -> list[tuple[str, float, float]]:
+    """(name, lower, upper) of the joints the sampler moves, in tree (robot.json) order."""
+    out = []
+    for joint in robot.joints:
+        if joint.type not in SAMPLED_TYPES:
+            continue
+        if joint.type == "continuous" or joint.lower is None or joint.upper is None:
+            out.append((joint.name, -math.pi, math.pi))
+        else:
+            out.append((joint.name, joint.lower, joint.upper))
+    return out
+
+
+def sample_unit(seed: int, samples: int, joints: int) -> np.ndarray:
+    """The unit-cube draws behind the sampled configurations (samples x joints)."""
+    return np.random.default_rng(seed).random((samples, joints))
+
+
+def configurations(robot: Robot, seed: int, samples: int = SAMPLES) -> np.ndarray:
+    """Random joint positions within the limits (samples x sampled joints)."""
+    limits = np.array([(lo, hi) for _, lo, hi in sampled_joints(robot)], dtype=float)
+    unit = sample_unit(seed, samples, len(limits))
+    if not len(limits):
+        return unit
+    return limits[:, 0] + unit * (limits[:, 1] - limits[:, 0])
+
+
+def _text(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+def _shape_geom(body: ET.Element, shape: Shape) -> None:
+    attrs = {"pos": _text(shape.xyz), "quat": _text(quat_wxyz(rpy_matrix(shape.rpy)))}
+    if shape.kind == "box":
+        attrs.update(type="box", size=_text(np.asarray(shape.size) / 2))
+    elif shape.kind == "sphere":
+        attrs.update(type="sphere", size=_text([shape.radius]))
+    else:  # cylinder, capsule: radius and half-length along local z
+        attrs.update(type=shape.kind, size=_text([shape.radius, shape.length / 2]))
+    ET.SubElement(body, "geom", attrs)
+
+
+def _mesh_geom(asset: ET.Element, body: ET.Element, name: str, vertices: np.ndarray) -> None:
+    # Vertices only: MuJoCo collides the convex hull of a mesh.
+    ET.SubElement(asset, "mesh", name=name, vertex=_text(vertices))
+    ET.SubElement(body, "geom", type="mesh", mesh=name)
+
+
+def collision_model_xml(robot: Robot, skip: list[tuple[str, str]] = ()) -> str:
+    """MJCF of the links' collision geometry, every link pair able to touch except `skip`:
+    every body has a degree of freedom (fixed joints get a locked slide) so MuJoCo welds none
+    together, and the parent filter is off."""
+    root = ET.Element("mujoco", model=f"{robot.name}_collision_pairs")
+    ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false")
+    option = ET.SubElement(root, "option")
+    ET.SubElement(option, "flag", filterparent="disable", gravity="disable")
+    ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin="0")
+    asset = ET.SubElement(root, "asset")
+    bodies = {robot.root: ET.SubElement(root, "worldbody")}
+    for joint in robot.joints:
+        link = robot.link(joint.child)
+        quat = quat_wxyz(rpy_matrix(joint.rpy))
+        body = ET.SubElement(
+            bodies[joint.parent], "body", name=link.name, pos=_text(joint.xyz), quat=_text(quat)
+        )
+        bodies[link.name] = body
+        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+        if joint.type in ("revolute", "continuous"):
+            ET.SubElement(body, "joint", name=joint.name, type="hinge", axis=_text(joint.axis))
+        elif joint.type == "prismatic":
+            ET.SubElement(body, "joint", name=joint.name, type="slide", axis=_text(joint.axis))
+        else:  # held at 0 by never being moved
+            ET.SubElement(body, "joint", name=f"{joint.name}_locked", type="slide")
+        if link.collision_primitives:
+            for shape in link.collision_primitives:
+                _shape_geom(body, shape)
+        elif link.collision:
+            for i, piece in enumerate(link.collision):
+                _mesh_geom(asset, body, f"{link.name}_{i:02d}", piece.vertices)
+        elif link.solid is not None:
+            _mesh_geom(asset, body, link.name, link.solid.vertices)
+    contact = ET.SubElement(root, "contact")
+    for a, b in skip:
+        ET.SubElement(contact, "exclude", body1=a, body2=b)
+    return ET.tostring(root, encoding="unicode")
+
+
+def first_contacts(
+    robot: Robot,
+    q: np.ndarray,
+    skip: list[tuple[str, str]] = (),
+) -> dict[tuple[str, str], int | None]:
+    """For each link pair with geometry (except `skip`), the index of the first configuration
+    (row of `q`) in which its collision geometry is in contact, or None if it never is.
+
+    A pair is only tested until its first contact: the model is rebuilt, excluding the pairs
+    found so far, after batches of doubling size. That gives the same answer as testing every
+    pair in every configuration, in a fraction of the time (the costly pairs are the close
+    ones, and they touch early)."""
+    import mujoco
+
+    solid = sorted(link.name for link in robot.links if has_geometry(link))
+    first: dict[tuple[str, str], int | None] = {
+        pair: None for pair in itertools.combinations(solid, 2) if pair not in set(skip)
+    }
+    names = [j for j, _, _ in sampled_joints(robot)]
+    start, batch = 0, 64
+    while start < len(q) and any(v is None for v in first.values()):
+        found = [pair for pair, v in first.items() if v is not None]
+        model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, [*skip, *found]))
+        data = mujoco.MjData(model)
+        adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
+        body_name = [model.body(i).name for i in range(model.nbody)]
+        for index in range(start, min(start + batch, len(q))):
+            data.qpos[adr] = q[index]
+            mujoco.mj_kinematics(model, data)
+            mujoco.mj_collision(model, data)
+            for g1, g2 in data.contact.geom[: data.ncon]:
+                a, b = body_name[model.geom_bodyid[g1]], body_name[model.geom_bodyid[g2]]
+                pair = (a, b) if a < b else (b, a)
+                if first[pair] is None:
+                    first[pair] = index
+        start += batch
+        batch *= 2
+    return first
+
+
+def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
+    """Adjacent and never-in-contact link pairs into `derived["collision_pairs"]` and
+    robot.json `collision_pairs`; the seed is the spec's."""
+    from simkit.derive.steps import with_json
+
+    seed = robot.seed
+    adjacent = adjacent_pairs(robot)
+    first = first_contacts(robot, configurations(robot, seed, samples), adjacent)
+    block = {
+        "method": METHOD,
+        "seed": seed,
+        "samples": samples,
+        "joints": [name for name, _, _ in sampled_joints(robot)],
+        "adjacent": [list(p) for p in adjacent],
+        "never": [list(p) for p, index in first.items() if index is None],
+        "first_contact": {f"{a} {b}": i for (a, b), i in first.items() if i is not None},
+    }
+    seeds = {**robot.derived.get("seeds", {}), "collision_pairs": seed}
+    robot = replace(robot, derived={**robot.derived, "collision_pairs": block, "seeds": seeds})
+    return with_json(robot, "collision_pairs", block)

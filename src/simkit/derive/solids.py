@@ -1,0 +1,89 @@
+"""Link solids: one watertight solid per link from the spec's primitives, with manifold3d.
+
+Union first (in spec order), then subtract the `subtract: true` primitives. Round shapes
+use a fixed segment count so output is deterministic.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import manifold3d as mf
+import numpy as np
+
+from simkit.errors import SpecError
+from simkit.model.kinematics import rpy_matrix
+from simkit.model.robot import Mesh, Shape
+
+CIRCULAR_SEGMENTS = 48
+
+
+def _placed(solid: mf.Manifold, shape: Shape) -> mf.Manifold:
+    rot = rpy_matrix(shape.rpy)
+    affine = np.hstack([rot, np.asarray(shape.xyz, float).reshape(3, 1)])
+    return solid.transform(affine.tolist())
+
+
+def _load_mesh(shape: Shape, base_dir: Path) -> mf.Manifold:
+    import trimesh  # lazy: trimesh import is slow and only mesh-sourced links need it
+
+    path = (base_dir / shape.file).resolve() if shape.file else None
+    if path is None or not path.is_file():
+        raise SpecError(str(base_dir), None, "solid.file", f"mesh file not found: {shape.file}")
+    mesh = trimesh.load_mesh(path, force="mesh", process=True)
+    verts = np.asarray(mesh.vertices, dtype=np.float32) * shape.scale
+    solid = mf.Manifold(mf.Mesh(vert_properties=verts, tri_verts=np.asarray(mesh.faces, np.uint32)))
+    if solid.status() != mf.Error.NoError or solid.is_empty():
+        raise SpecError(str(path), None, "solid.file", "mesh is not a closed, manifold solid")
+    return solid
+
+
+def primitive_solid(shape: Shape, base_dir: Path | None = None) -> mf.Manifold:
+    """The manifold of one primitive, placed in the link frame."""
+    kind = shape.kind
+    if kind == "box":
+        solid = mf.Manifold.cube(tuple(shape.size), center=True)  # type: ignore[arg-type]
+    elif kind == "cylinder":
+        solid = mf.Manifold.cylinder(
+            shape.length, shape.radius, shape.radius, CIRCULAR_SEGMENTS, center=True
+        )
+    elif kind == "cone":
+        solid = mf.Manifold.cylinder(
+            shape.length, shape.radius, shape.radius_top, CIRCULAR_SEGMENTS, center=True
+        )
+    elif kind == "sphere":
+        solid = mf.Manifold.sphere(shape.radius, CIRCULAR_SEGMENTS)
+    elif kind == "capsule":
+        half = shape.length / 2
+        ball = mf.Manifold.sphere(shape.radius, CIRCULAR_SEGMENTS)
+        solid = mf.Manifold.batch_hull(
+            [ball.translate((0, 0, -half)), ball.translate((0, 0, half))]
+        )
+    elif kind == "mesh":
+        solid = _load_mesh(shape, base_dir or Path("."))
+    else:  # pragma: no cover - the schema only admits the kinds above
+        raise ValueError(kind)
+    return _placed(solid, shape)
+
+
+def link_solid(shapes: tuple[Shape, ...], base_dir: Path | None = None) -> Mesh:
+    """Union the additive primitives, subtract the rest; return a watertight mesh (m)."""
+    add = [primitive_solid(s, base_dir) for s in shapes if not s.subtract]
+    cut = [primitive_solid(s, base_dir) for s in shapes if s.subtract]
+    solid = mf.Manifold.batch_boolean(add, mf.OpType.Add) if len(add) > 1 else add[0]
+    if cut:
+        solid = solid - mf.Manifold.batch_boolean(cut, mf.OpType.Add)
+    return to_mesh(solid)
+
+
+def to_mesh(solid: mf.Manifold) -> Mesh:
+    """Convert a manifold to a read-only model `Mesh` (float64 vertices)."""
+    out = solid.to_mesh64() if hasattr(solid, "to_mesh64") else solid.to_mesh()
+    verts = np.asarray(out.vert_properties, dtype=np.float64)[:, :3]
+    faces = np.asarray(out.tri_verts, dtype=np.int64)
+    return Mesh.of(verts, faces)
+
+
+def is_convex_union(shapes: tuple[Shape, ...]) -> bool:
+    """True when the solid is a plain union of convex primitives (no subtraction, no mesh)."""
+    return bool(shapes) and all(not s.subtract and s.kind != "mesh" for s in shapes)

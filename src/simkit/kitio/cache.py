@@ -1,0 +1,339 @@
+"""Content-addressed disk cache for slow pure steps (link solids, CoACD collision pieces).
+
+Design notes (shared/DESIGN.md, "Cache"; issue 3): the key is the SHA-256 of the input bytes,
+the step's name and version, the library versions and every parameter, so a change to any of
+them misses instead of serving a stale result (onshape-to-robot keyed CoACD by file only).
+Entries are `.npz` files written with `allow_pickle=False` semantics (plain arrays, JSON as
+uint8 bytes), published atomically (`os.replace` of a temp file in the same folder), and carry
+a SHA-256 of their own content: a truncated, edited or unreadable entry is a miss, is deleted,
+and the step recomputes and rewrites it.
+
+Location: `--cache-dir`, else `$SIMKIT_CACHE_DIR`, else the user cache folder (XDG on Linux,
+via platformdirs).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+import tempfile
+import zipfile
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from simkit import __version__
+
+ENV_DIR = "SIMKIT_CACHE_DIR"
+_DIGEST = "__sha256__"
+
+Arrays = dict[str, np.ndarray]
+
+
+def default_dir() -> Path:
+    """`$SIMKIT_CACHE_DIR`, else the platform's user cache folder for simkit."""
+    env = os.environ.get(ENV_DIR)
+    if env:
+        return Path(env).expanduser()
+    from platformdirs import user_cache_dir  # lazy: only needed when no folder is given
+
+    return Path(user_cache_dir("simkit", appauthor=False))
+
+
+def library_version(name: str) -> str:
+    """Installed version of a distribution (part of every key that uses that library)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return "none"
+
+
+def _canonical(value: object) -> object:
+    """Parameters as JSON-able data with a fixed float representation (repr round-trips)."""
+    if isinstance(value, Mapping):
+        return {str(k): _canonical(v) for k, v in sorted(value.items(), key=lambda kv: str(kv[0]))}
+    if isinstance(value, (list, tuple)):
+        return [_canonical(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return hashlib.sha256(np.ascontiguousarray(value).tobytes()).hexdigest()
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    raise TypeError(f"cache key cannot hold {type(value).__name__}")
+
+
+def make_key(
+    step: str,
+    version: int,
+    inputs: list[bytes],
+    params: Mapping[str, object],
+    libraries: tuple[str, ...] = (),
+) -> str:
+    """SHA-256 hex key of the input bytes, step name and version, simkit and library versions,
+    and every parameter."""
+    h = hashlib.sha256()
+    head = {
+        "step": step,
+        "version": version,
+        "simkit": __version__,
+        "libraries": {name: library_version(name) for name in sorted(libraries)},
+        "params": _canonical(params),
+    }
+    h.update(json.dumps(head, sort_keys=True).encode("utf-8"))
+    for blob in inputs:
+        h.update(len(blob).to_bytes(8, "little"))
+        h.update(hashlib.sha256(blob).digest())
+    return h.hexdigest()
+
+
+def _content_digest(arrays: Arrays) -> str:
+    h = hashlib.sha256()
+    for name in sorted(arrays):
+        arr = np.ascontiguousarray(arrays[name])
+        h.update(f"{name}|{arr.dtype.str}|{arr.shape}|".encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()
+
+
+def encode_json(value: object) -> np.ndarray:
+    """JSON data as a uint8 array, so metadata travels in the npz without pickle."""
+    return np.frombuffer(json.dumps(value).encode("utf-8"), dtype=np.uint8)
+
+
+def decode_json(arr: np.ndarray) -> object:
+    return json.loads(np.asarray(arr, dtype=np.uint8).tobytes().decode("utf-8"))
+
+
+@dataclass
+class Stats:
+    """Hits, misses and repaired (corrupt) entries per step, for tests and the bench."""
+
+    hits: dict[str, int] = field(default_factory=dict)
+    misses: dict[str, int] = field(default_factory=dict)
+    repaired: dict[str, int] = field(default_factory=dict)
+
+    def bump(self, table: dict[str, int], step: str) -> None:
+        table[step] = table.get(step, 0) + 1
+
+
+@dataclass
+class Cache:
+    """A cache folder; `enabled=False` (`--no-cache`) computes every step and stores nothing."""
+
+    root: Path | None
+    enabled: bool = True
+    stats: Stats = field(default_factory=Stats)
+
+    @staticmethod
+    def at(root: Path | str | None = None, enabled: bool = True) -> Cache:
+        """The cache at `root` (default: env, then user cache folder)."""
+        return Cache(Path(root).expanduser() if root else default_dir(), enabled)
+
+    @staticmethod
+    def disabled() -> Cache:
+        return Cache(None, enabled=False)
+
+    def path(self, step: str, key: str) -> Path:
+        assert self.root is not None
+        return self.root / step / key[:2] / f"{key}.npz"
+
+    def get(self, step: str, key: str) -> Arrays | None:
+        """The stored arrays, or None on a miss. A corrupt entry is deleted and counted."""
+        if not self.enabled:
+            return None
+        path = self.path(step, key)
+        try:
+            data = path.read_bytes()
+        except OSError:
+            self.stats.bump(self.stats.misses, step)
+            return None
+        arrays = _decode(data)
+        if arrays is None:
+            path.unlink(missing_ok=True)
+            self.stats.bump(self.stats.repaired, step)
+            self.stats.bump(self.stats.misses, step)
+            return None
+        self.stats.bump(self.stats.hits, step)
+        return arrays
+
+    def put(self, step: str, key: str, arrays: Arrays) -> None:
+        """Store atomically: write a temp file beside the entry, then `os.replace` it."""
+        if not self.enabled:
+            return
+        payload = {name: np.ascontiguousarray(a) for name, a in arrays.items()}
+        if any(a.dtype.hasobject for a in payload.values()):
+            raise TypeError("cache entries hold plain arrays only (no pickled objects)")
+        path = self.path(step, key)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        payload[_DIGEST] = np.frombuffer(_content_digest(payload).encode("ascii"), dtype=np.uint8)
+        buf = io.BytesIO()
+        np.savez(buf, **payload)
+        fd, tmp = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".tmp", dir=path.parent)
+        try:
+            with os.fdopen(fd, "wb") as handle:
+                handle.write(buf.getvalue())
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
+    def memo(self, step: str, key: str, compute: Callable[[], Arrays]) -> Arrays:
+        """`get`, else `compute` and `put`."""
+        found = self.get(step, key)
+        if found is not None:
+            return found
+        result = compute()
+        self.put(step, key, result)
+        return result
+
+
+def _decode(data: bytes) -> Arrays | None:
+    """Arrays of an entry, or None when it is unreadable or its digest does not match."""
+    try:
+        with np.load(io.BytesIO(data), allow_pickle=False) as npz:
+            arrays = {name: npz[name] for name in npz.files}
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile):
+        return None
+    stored = arrays.pop(_DIGEST, None)
+    if stored is None or stored.tobytes().decode("ascii", "replace") != _content_digest(arrays):
+        return None
+    return arrays
+
+
+# --- whole-robot derive steps -----------------------------------------------------------
+
+
+def code_digest() -> str:
+    """SHA-256 of simkit's own source files: the version of a robot-level step, so editing
+    any module (a step or what it calls) invalidates its cached results."""
+    global _CODE_DIGEST
+    if _CODE_DIGEST is None:
+        package = Path(__file__).resolve().parents[1]  # every module of simkit
+        h = hashlib.sha256(__version__.encode())
+        for path in sorted(package.rglob("*.py")):
+            h.update(path.relative_to(package).as_posix().encode())
+            h.update(path.read_bytes())
+        _CODE_DIGEST = h.hexdigest()
+    return _CODE_DIGEST
+
+
+_CODE_DIGEST: str | None = None
+
+
+def digest(value: object) -> str:
+    """SHA-256 of a value's content: dataclasses by field, pydantic models by dump, arrays by
+    bytes, floats by repr. Used to key a step on the whole `Robot` it reads."""
+    from dataclasses import fields, is_dataclass
+
+    h = hashlib.sha256()
+
+    def feed(v: object) -> None:
+        if is_dataclass(v) and not isinstance(v, type):
+            h.update(f"<{type(v).__name__}".encode())
+            for f in fields(v):
+                h.update(f.name.encode())
+                feed(getattr(v, f.name))
+            h.update(b">")
+        elif hasattr(v, "model_dump"):
+            feed(v.model_dump())  # type: ignore[union-attr]
+        elif isinstance(v, np.ndarray):
+            h.update(f"a{v.dtype.str}{v.shape}".encode())
+            h.update(np.ascontiguousarray(v).tobytes())
+        elif isinstance(v, Mapping):
+            h.update(b"{")
+            for k in sorted(v, key=str):
+                feed(str(k))
+                feed(v[k])
+            h.update(b"}")
+        elif isinstance(v, (list, tuple)):
+            h.update(b"[" if isinstance(v, list) else b"(")
+            for item in v:
+                feed(item)
+            h.update(b"]")
+        else:
+            h.update(f"{type(v).__name__}:{v!r};".encode())
+
+    feed(value)
+    return h.hexdigest()
+
+
+def derived_step(robot, cache: Cache, name: str, step: Callable):
+    """Run `step(robot) -> robot` through the cache when it only adds or replaces JSON-exact
+    entries of `robot.derived` (else it just runs). Key: the whole input robot, simkit's
+    source, and the numeric libraries' versions."""
+    from dataclasses import replace
+
+    if not cache.enabled:
+        return step(robot)
+    key = make_key(
+        f"derived_{name}",
+        1,
+        [digest(robot).encode(), code_digest().encode()],
+        {},
+        ("numpy", "mujoco", "manifold3d"),
+    )
+    found = cache.get(f"derived_{name}", key)
+    if found is not None:
+        extra = _join(decode_json(found["derived"]), found)
+        return replace(robot, derived={**robot.derived, **extra})  # type: ignore[dict-item]
+    out = step(robot)
+    changed = {
+        k: v for k, v in out.derived.items() if k not in robot.derived or robot.derived[k] is not v
+    }
+    arrays: Arrays = {}
+    try:
+        skeleton = _split(changed, arrays)
+        exact = json.loads(json.dumps(skeleton)) == skeleton
+    except (TypeError, ValueError):
+        exact = False
+    if exact and replace(out, derived=robot.derived) == robot:
+        cache.put(f"derived_{name}", key, {"derived": encode_json(skeleton), **arrays})
+    return out
+
+
+_ARRAY = "__ndarray__"
+
+
+def _split(value: object, arrays: Arrays) -> object:
+    """JSON skeleton of `value` with each numpy array moved into `arrays` (raises TypeError
+    for anything JSON cannot hold exactly, such as tuples)."""
+    if isinstance(value, np.ndarray):
+        if value.dtype.hasobject:
+            raise TypeError("object array")
+        name = f"a{len(arrays)}"
+        arrays[name] = value
+        return {_ARRAY: name}
+    if isinstance(value, dict):
+        if not all(isinstance(k, str) for k in value) or _ARRAY in value:
+            raise TypeError("keys")
+        return {k: _split(v, arrays) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_split(v, arrays) for v in value]
+    if value is None or type(value) in (bool, int, float, str):
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating) and value.dtype == np.float64:
+        return float(value)  # the same double; emitters format both alike
+    raise TypeError(type(value).__name__)
+
+
+def _join(value: object, arrays: Mapping[str, np.ndarray]) -> object:
+    if isinstance(value, dict):
+        if set(value) == {_ARRAY}:
+            return arrays[value[_ARRAY]]
+        return {k: _join(v, arrays) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_join(v, arrays) for v in value]
+    return value

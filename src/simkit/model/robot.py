@@ -1,0 +1,255 @@
+"""The frozen, format-neutral robot model every emitter and check reads. SI units throughout.
+
+Nobody mutates a `Robot`: derive steps return a new one with `dataclasses.replace`.
+Transforms follow `T_a_b` = pose of frame b in frame a.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from simkit.spec.mjcf import MjcfSpec
+    from simkit.spec.sim import FreefallSpec, Ros2ControlSpec
+
+Vec3 = tuple[float, float, float]
+Rgba = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """Mass (kg), CoM (m, link frame) and inertia about the CoM in link axes (kg m^2),
+    stored as (ixx, iyy, izz, ixy, ixz, iyz)."""
+
+    mass: float
+    com: Vec3
+    inertia: tuple[float, float, float, float, float, float]
+
+    def tensor(self) -> np.ndarray:
+        """The 3x3 inertia tensor about the CoM, link axes."""
+        ixx, iyy, izz, ixy, ixz, iyz = self.inertia
+        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A solid primitive placed in its link frame. Round shapes run along local z;
+    `length` is the cylinder length or the capsule's centre-to-centre length (m)."""
+
+    kind: str
+    xyz: Vec3
+    rpy: Vec3
+    size: Vec3 | None = None
+    radius: float | None = None
+    radius_top: float | None = None
+    length: float | None = None
+    file: str | None = None
+    scale: float = 1.0
+    subtract: bool = False
+    geom_class: str | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Mesh:
+    """A triangle mesh in a link frame (m). Arrays are read-only so the model stays frozen."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    @staticmethod
+    def of(vertices: np.ndarray, faces: np.ndarray) -> Mesh:
+        v = np.ascontiguousarray(vertices, dtype=np.float64)
+        f = np.ascontiguousarray(faces, dtype=np.int64)
+        v.setflags(write=False)
+        f.setflags(write=False)
+        return Mesh(v, f)
+
+
+@dataclass(frozen=True)
+class InertiaDecision:
+    """A recorded decision to keep a non-physical reported inertia (spec_sim.py): the reported
+    tensor and the problem with it, and the balanced tensor the URDF and MJCF carry instead
+    (filled by the derive step; (ixx, iyy, izz, ixy, ixz, iyz), kg m^2)."""
+
+    action: str
+    reason: str
+    reported: tuple[float, float, float, float, float, float]
+    problem: str
+    emitted: tuple[float, float, float, float, float, float] | None = None
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid body. `solid` is the visual solid (None until derived); `collision` holds the
+    convex pieces or primitives (empty until derived)."""
+
+    name: str
+    mass: float
+    inertial: Inertial | None
+    material: str | None
+    shapes: tuple[Shape, ...]
+    collision_method: str
+    collision_primitives: tuple[Shape, ...] = ()
+    estimated: tuple[str, ...] = ()
+    note: str | None = None
+    solid: Mesh | None = None
+    collision: tuple[Mesh, ...] = ()
+    collision_report: dict | None = None
+    inertia_decision: InertiaDecision | None = None
+
+
+@dataclass(frozen=True)
+class Drive:
+    """Motor and gearbox data behind a joint's armature and peak torque."""
+
+    motor: str | None
+    motor_peak_torque: float
+    rotor_inertia: float
+    gearbox: str | None
+    gear_ratio: float
+    gear_inertia: float
+    efficiency: float
+    gear_max_output_torque: float | None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint; `xyz`/`rpy` give T_parent_child at q = 0. Angles in rad, speeds in rad/s."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: Vec3
+    rpy: Vec3
+    axis: Vec3
+    lower: float | None = None
+    upper: float | None = None
+    max_velocity: float | None = None
+    effort_peak: float | None = None
+    effort_continuous: float | None = None
+    drive_peak_torque_at_joint: float | None = None
+    armature: float = 0.0
+    damping: float = 0.0
+    friction: float = 0.0
+    stiffness: float = 0.0
+    springref: float = 0.0
+    actuated: bool = True
+    drive: Drive | None = None
+    estimated: tuple[str, ...] = ()
+    solreflimit: tuple[float, float] | None = None
+    solimplimit: tuple[float, float, float] | None = None
+    margin: float = 0.0
+    kp: float | None = None
+    kv: float | None = None
+    mjcf_class: str | None = None
+
+    @property
+    def movable(self) -> bool:
+        """A one-degree-of-freedom joint (a floating base is neither fixed nor 1-DOF: it has
+        no entry in poses, robot.json `joints` or the servos)."""
+        return self.type not in ("fixed", "floating")
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A massless frame fixed to `parent` (a link or the root)."""
+
+    name: str
+    parent: str
+    xyz: Vec3
+    rpy: Vec3
+    estimated: tuple[str, ...] = ()
+    site_size: float | None = None
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """A position servo on a joint: kp (N m/rad), kv (N m s/rad), force limit (N m)."""
+
+    joint: str
+    kp: float
+    kv: float
+    forcerange: float
+
+
+@dataclass(frozen=True)
+class PlanningGroup:
+    """A MoveIt planning group: the chain from link `base` to link or frame `tip`."""
+
+    name: str
+    base: str
+    tip: str
+
+
+@dataclass(frozen=True)
+class Robot:
+    """The whole robot: links and joints in tree order (parents before children)."""
+
+    name: str
+    title: str
+    description: str
+    root: str
+    floating_base: bool
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...]
+    frames: tuple[Frame, ...]
+    materials: tuple[tuple[str, Rgba], ...]
+    poses: tuple[tuple[str, tuple[float, ...]], ...]
+    published: dict
+    published_estimated: tuple[str, ...]
+    sources: tuple[str, ...]
+    wrist_centre: str | None
+    tool_frame: str | None
+    seed: int
+    spec_sha256: str
+    spec_file: str
+    actuators: tuple[Actuator, ...] = ()
+    derived: dict = field(default_factory=dict)
+    planning_groups: tuple[PlanningGroup, ...] = ()
+    #: MuJoCo scene settings (`spec_mjcf.MjcfSpec`, frozen), or None for simkit's defaults.
+    mjcf: MjcfSpec | None = None
+    asset_dir: str | None = None
+    #: Gazebo / ros2_control additions and the free-fall validation (frozen spec sections)
+    ros2_control: Ros2ControlSpec | None = None
+    freefall: FreefallSpec | None = None
+
+    def link(self, name: str) -> Link:
+        for link in self.links:
+            if link.name == name:
+                return link
+        raise KeyError(name)
+
+    def joint(self, name: str) -> Joint:
+        for joint in self.joints:
+            if joint.name == name:
+                return joint
+        raise KeyError(name)
+
+    @property
+    def floating_joint(self) -> Joint | None:
+        """The free joint between the root and the floating base link, if any."""
+        return next((j for j in self.joints if j.type == "floating"), None)
+
+    @property
+    def movable_joints(self) -> tuple[Joint, ...]:
+        return tuple(j for j in self.joints if j.movable)
+
+    def pose(self, name: str) -> tuple[float, ...]:
+        return dict(self.poses)[name]
+
+    @property
+    def total_mass(self) -> float:
+        return sum(link.mass for link in self.links)
+
+    def parent_joint(self, link_name: str) -> Joint | None:
+        for joint in self.joints:
+            if joint.child == link_name:
+                return joint
+        return None
+
+    def material_rgba(self, name: str | None) -> Rgba:
+        return dict(self.materials).get(name or "", (0.7, 0.7, 0.7, 1.0))

@@ -1,0 +1,1 @@
+"""The simulate stage: MuJoCo runs on the staged (written) files, returning plain reports."""

@@ -1,0 +1,278 @@
+"""The spec schema: what a person writes in robots/NAME.yaml.
+
+Every model forbids unknown keys. Angles may be given in radians (`lower`) or degrees
+(`lower_deg`); the resolver turns everything into SI. Values that no source publishes are
+listed by field name in the entity's `estimated` list, and that list ends up in robot.json.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from simkit.spec.mjcf import MjcfSpec
+from simkit.spec.sim import FreefallSpec, InertiaDecisionSpec, Ros2ControlSpec
+
+Vec3 = tuple[float, float, float]
+Rgba = tuple[float, float, float, float]
+PositiveFloat = Annotated[float, Field(gt=0)]
+NonNegFloat = Annotated[float, Field(ge=0)]
+
+
+class Strict(BaseModel):
+    """Base: frozen, no unknown keys, finite floats only."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class Placed(Strict):
+    """A pose given as translation (m) and roll-pitch-yaw, in radians or degrees."""
+
+    xyz: Vec3 = (0.0, 0.0, 0.0)
+    rpy: Vec3 | None = None
+    rpy_deg: Vec3 | None = None
+
+    @model_validator(mode="after")
+    def _one_rpy(self) -> Placed:
+        if self.rpy is not None and self.rpy_deg is not None:
+            raise ValueError("give rpy or rpy_deg, not both")
+        return self
+
+    def rpy_rad(self) -> Vec3:
+        """Orientation in radians."""
+        if self.rpy_deg is not None:
+            return tuple(math.radians(a) for a in self.rpy_deg)  # type: ignore[return-value]
+        return self.rpy or (0.0, 0.0, 0.0)
+
+
+class Primitive(Placed):
+    """One solid primitive in the link frame. Round shapes run along their local z axis,
+    centred on `xyz`, unless `from`/`to` give the two end centres."""
+
+    shape: Literal["box", "cylinder", "cone", "capsule", "sphere", "mesh"]
+    size: Vec3 | None = None
+    radius: PositiveFloat | None = None
+    radius_top: NonNegFloat | None = None
+    length: PositiveFloat | None = None
+    from_: Vec3 | None = Field(default=None, alias="from")
+    to: Vec3 | None = None
+    file: str | None = None
+    scale: PositiveFloat = 1.0
+    subtract: bool = False
+
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, allow_inf_nan=False, populate_by_name=True
+    )
+
+    @model_validator(mode="after")
+    def _complete(self) -> Primitive:
+        need = {
+            "box": ("size",),
+            "cylinder": ("radius",),
+            "cone": ("radius", "radius_top"),
+            "capsule": ("radius",),
+            "sphere": ("radius",),
+            "mesh": ("file",),
+        }[self.shape]
+        for name in need:
+            if getattr(self, name) is None:
+                raise ValueError(f"a {self.shape} needs '{name}'")
+        if self.shape in ("cylinder", "cone", "capsule"):
+            ends = (self.from_ is not None) + (self.to is not None)
+            if ends == 1:
+                raise ValueError("give both 'from' and 'to'")
+            if ends == 0 and self.length is None:
+                raise ValueError(f"a {self.shape} needs 'length' or 'from'/'to'")
+            if ends == 2 and math.dist(self.from_, self.to) <= 0:  # type: ignore[arg-type]
+                raise ValueError("'from' and 'to' must differ")
+        if self.size is not None and min(self.size) <= 0:
+            raise ValueError("box size must be positive")
+        return self
+
+
+class CollisionPrimitive(Placed):
+    """A collision primitive that the MJCF, URDF and USD emit as a primitive."""
+
+    shape: Literal["box", "cylinder", "capsule", "sphere"]
+    size: Vec3 | None = None
+    radius: PositiveFloat | None = None
+    length: PositiveFloat | None = None
+    from_: Vec3 | None = Field(default=None, alias="from")
+    to: Vec3 | None = None
+    geom_class: str | None = None
+
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, allow_inf_nan=False, populate_by_name=True
+    )
+
+
+class InertiaSpec(Strict):
+    """Inertia tensor about the CoM, in the link frame (kg m^2)."""
+
+    ixx: float
+    iyy: float
+    izz: float
+    ixy: float = 0.0
+    ixz: float = 0.0
+    iyz: float = 0.0
+
+
+class LinkSpec(Strict):
+    """A rigid body: its solid, mass, optional CoM/inertia, and colour."""
+
+    name: str
+    mass: float
+    com: Vec3 | None = None
+    inertia: InertiaSpec | None = None
+    material: str | None = None
+    solid: tuple[Primitive, ...] = ()
+    collision: Literal["auto", "convex", "coacd", "primitives", "mesh"] = "auto"
+    collision_primitives: tuple[CollisionPrimitive, ...] = ()
+    estimated: tuple[str, ...] = ()
+    note: str | None = None
+    #: keep a non-physical reported inertia on purpose (spec_sim.InertiaDecisionSpec)
+    inertia_decision: InertiaDecisionSpec | None = None
+
+    @field_validator("mass")
+    @classmethod
+    def _positive_mass(cls, value: float) -> float:
+        if value <= 0:
+            raise ValueError(f"mass must be > 0 kg (got {value})")
+        return value
+
+
+class DriveSpec(Strict):
+    """Motor and gearbox; the resolver derives armature and the drive's peak joint torque."""
+
+    motor: str | None = None
+    motor_peak_torque: PositiveFloat
+    rotor_inertia: NonNegFloat
+    gearbox: str | None = None
+    gear_ratio: PositiveFloat
+    gear_inertia: NonNegFloat = 0.0
+    efficiency: Annotated[float, Field(gt=0, le=1)] = 1.0
+    gear_max_output_torque: PositiveFloat | None = None
+    estimated: tuple[str, ...] = ()
+
+
+class JointSpec(Placed):
+    """A joint between two links. `xyz`/`rpy` place the child frame in the parent frame."""
+
+    name: str
+    type: Literal["revolute", "continuous", "prismatic", "fixed", "floating"] = "revolute"
+    parent: str
+    child: str
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    lower: float | None = None
+    upper: float | None = None
+    lower_deg: float | None = None
+    upper_deg: float | None = None
+    max_velocity: PositiveFloat | None = None
+    max_velocity_deg_s: PositiveFloat | None = None
+    effort_peak: PositiveFloat | None = None
+    effort_continuous: PositiveFloat | None = None
+    drive_peak_torque_at_joint: PositiveFloat | None = None
+    armature: NonNegFloat | None = None
+    drive: DriveSpec | None = None
+    damping: NonNegFloat = 0.0
+    friction: NonNegFloat = 0.0
+    stiffness: NonNegFloat = 0.0
+    springref: float = 0.0
+    actuated: bool = True
+    # Joint-limit contact (MuJoCo solreflimit, solimplimit, margin in rad or m), servo gains
+    # (N m/rad, N m s/rad; derived from effort_peak when absent) and the MJCF default class.
+    solreflimit: tuple[float, float] | None = None
+    solimplimit: tuple[float, float, float] | None = None
+    margin: NonNegFloat = 0.0
+    kp: PositiveFloat | None = None
+    kv: NonNegFloat | None = None
+    mjcf_class: str | None = None
+    estimated: tuple[str, ...] = ()
+
+    @model_validator(mode="after")
+    def _units_once(self) -> JointSpec:
+        for rad, deg in (
+            ("lower", "lower_deg"),
+            ("upper", "upper_deg"),
+            ("max_velocity", "max_velocity_deg_s"),
+        ):
+            if getattr(self, rad) is not None and getattr(self, deg) is not None:
+                raise ValueError(f"give {rad} or {deg}, not both")
+        return self
+
+    @field_validator("axis")
+    @classmethod
+    def _nonzero_axis(cls, axis: Vec3) -> Vec3:
+        if math.sqrt(sum(a * a for a in axis)) < 1e-9:
+            raise ValueError("axis must not be zero")
+        return axis
+
+
+class FrameSpec(Placed):
+    """A massless frame fixed to a link (tool0, sensor sites, ...)."""
+
+    name: str
+    parent: str
+    site_size: PositiveFloat | None = None  # m, radius of the MJCF site (default 0.005)
+    estimated: tuple[str, ...] = ()
+
+
+class MaterialSpec(Strict):
+    name: str
+    rgba: Rgba
+
+
+class PublishedSpec(Strict):
+    """Published ratings and reference figures; the checks compare the outputs to these."""
+
+    mass: PositiveFloat | None = None
+    base_link_height: float | None = None
+    tool0_home: Vec3 | None = None
+    wrist_centre_reach: PositiveFloat | None = None
+    reach_wrist: PositiveFloat | None = None
+    reach_flange: PositiveFloat | None = None
+    payload: PositiveFloat | None = None
+    repeatability_mm: PositiveFloat | None = None
+    #: m above base_link of the benchmark cycle's low points (kit page, "Benchmark cycle")
+    benchmark_low_height: float | None = None
+    estimated: tuple[str, ...] = ()
+
+
+class PlanningGroupSpec(Strict):
+    """A MoveIt planning group: the kinematic chain from link `base` to link or frame `tip`
+    (SRDF `<chain>`). Without any, the SRDF has `manipulator`: base_link -> tool frame."""
+
+    name: str
+    base: str
+    tip: str
+
+
+class RobotSpec(Strict):
+    """The whole robot spec (one YAML file)."""
+
+    name: Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$")]
+    title: str
+    description: str = ""
+    sources: tuple[str, ...] = ()
+    root: str = "base_footprint"
+    floating_base: bool = False
+    wrist_centre: str | None = None
+    tool_frame: str | None = None
+    materials: tuple[MaterialSpec, ...] = ()
+    links: tuple[LinkSpec, ...]
+    joints: tuple[JointSpec, ...]
+    frames: tuple[FrameSpec, ...] = ()
+    poses_deg: dict[str, tuple[float, ...]] = Field(default_factory=dict)
+    poses: dict[str, tuple[float, ...]] = Field(default_factory=dict)
+    published: PublishedSpec = PublishedSpec()
+    seed: int = 0
+    mjcf: MjcfSpec | None = None
+    planning_groups: tuple[PlanningGroupSpec, ...] = ()
+    #: Folder name under the download site's /assets/sim/ (the page's `<model>`, e.g. "1000");
+    #: defaults to `name`.
+    asset_dir: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")] | None = None
+    #: Gazebo / ros2_control additions and the free-fall validation (spec_sim.py)
+    ros2_control: Ros2ControlSpec | None = None
+    freefall: FreefallSpec | None = None
