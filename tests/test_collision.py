@@ -138,7 +138,7 @@ def test_coacd_cached_warm_runs_none_and_corrupt_entries_are_repaired(tmp_path):
             assert all(_trimesh(p).is_convex for p in link.collision), link.name
             assert link.collision_report["coverage"] > 0.999
     assert cold.link("finger").collision == ()
-    assert cold.derived["seeds"]["coacd"] == cold.seed
+    assert cold.products.seeds["coacd"] == cold.seed
 
     start = collision.COACD_RUNS
     warm = model_from_spec(MIX, cache=Cache.at(tmp_path / "cache"), jobs=2)

@@ -88,7 +88,7 @@ def test_each_kind_of_change(rosie_1000, copy):
     # link_4's visual mesh scaled by 1.1: volume x 1.331, bounding box x 1.1
     stl = copy / "meshes" / "visual" / "link_4.stl"
     mesh = from_stl(stl.read_bytes())
-    stl.write_bytes(to_stl(type(mesh).of(mesh.vertices * 1.1, mesh.faces), "link_4"))
+    stl.write_bytes(to_stl(mesh._replace(vertices=mesh.vertices * 1.1), "link_4"))
     # one more convex piece for link_1, and README removed
     pieces = sorted((copy / "meshes" / "collision").glob("link_1_*.stl"))
     shutil.copy(pieces[0], copy / "meshes" / "collision" / f"link_1_{len(pieces):02d}.stl")

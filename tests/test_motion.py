@@ -14,6 +14,7 @@ import pytest
 
 from simkit.emit import motion_files, robot_json
 from simkit.model.kinematics import axis_angle, quat_wxyz, rpy_matrix, transform
+from simkit.model.robot import SimReports
 from simkit.pipeline import model_from_spec
 
 STEP = 1e-5  # s, finite-difference time step
@@ -145,7 +146,7 @@ def test_motion_profiles_and_jerk(doc):
 
 def test_robots_without_a_6r_arm_get_no_motion_products():
     robot = model_from_spec(str(Path(__file__).parent / "specs" / "planar_2r.yaml"))
-    doc = robot_json.document(robot)
+    doc = robot_json.document(robot, SimReports())
     assert not {"motion", "benchmarks", "ik_reference"} & set(doc)
     assert all("derived_max_acceleration" not in j for j in doc["joints"])
     assert motion_files.emit(robot) == {}

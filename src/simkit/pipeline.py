@@ -1,4 +1,6 @@
-"""The pipeline: load+validate -> resolve -> derive -> emit -> write (staging) -> check -> publish.
+"""The pipeline, the one place that knows the stage order: spec (load + validate) -> model
+(resolve) -> derive -> emit -> write to staging -> simulate (on the staged files) -> emit the
+report files -> check -> publish (swap kit and zip into place).
 
 A build writes into a staging folder beside the output, checks it there, then swaps it into
 place; a failure at any step leaves the previous kit and zip untouched.
@@ -15,15 +17,16 @@ from pathlib import Path
 
 from simkit.check import run_checks_cached
 from simkit.check.findings import Finding
-from simkit.derive.steps import derive_all
-from simkit.emit import EMITTERS, emit_all, usd
+from simkit.derive import derive_all
+from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.errors import CheckFailed, UnknownRobot
 from simkit.kitio import layout
 from simkit.kitio.archive import zip_bytes
-from simkit.kitio.cache import Cache
+from simkit.kitio.cache import Arrays, Cache, cached_stage, decode_json, digest, encode_json
 from simkit.kitio.resources import data_dir, robot_names
 from simkit.model.resolve import resolve
 from simkit.model.robot import Robot
+from simkit.simulate import simulate_all
 from simkit.spec.validate import load_spec
 
 Progress = Callable[[str], None]
@@ -73,47 +76,65 @@ def model_from_spec(
 
 #: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
 EMIT_LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core", "jinja2")
+#: Libraries the simulate stage's figures depend on.
+SIMULATE_LIBRARIES = ("numpy", "scipy", "mujoco", "matplotlib")
 
 
-def _emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes]:
-    """`emit_all`, reusing the files of an earlier build of an identical model.
-
-    Emitters are pure functions of the model and the templates (no clock, no randomness), so
-    the key is the model's content digest, simkit's source digest, every template's bytes,
-    the library versions and the options. On
-    a hit no emitter runs, so a warm rebuild does not even import pxr. Stored as one byte
-    blob plus a JSON index (no pickle), through the cache's digest-checked entries.
-    """
+def _pack_files(files: dict[str, bytes]) -> Arrays:
+    """Files as one byte blob plus a JSON index (no pickle), for a cache entry."""
     import numpy as np
 
-    from simkit.kitio.cache import code_digest, decode_json, digest, encode_json, make_key
-
-    templates = data_dir("templates")
-    template_bytes = [
-        part
-        for path in sorted(templates.rglob("*"))
-        if path.is_file()
-        for part in (path.relative_to(templates).as_posix().encode(), path.read_bytes())
-    ]
-    key = make_key(
-        "emit",
-        1,
-        [digest(robot).encode(), code_digest().encode(), *template_bytes],
-        {"usd_format": usd_format},
-        EMIT_LIBRARIES,
-    )
-    stored = cache.get("emit", key)
-    if stored is not None:
-        blob = stored["blob"].tobytes()
-        return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
-    files = emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)})
     index, offset = [], 0
     for path, data in files.items():
         index.append([path, offset, offset + len(data)])
         offset += len(data)
     blob = np.frombuffer(b"".join(files.values()), dtype=np.uint8)
-    cache.put("emit", key, {"index": encode_json(index), "blob": blob})
-    return files
+    return {"index": encode_json(index), "blob": blob}
+
+
+def _unpack_files(stored: Arrays) -> dict[str, bytes]:
+    blob = stored["blob"].tobytes()
+    return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
+
+
+def _template_bytes() -> list[bytes]:
+    templates = data_dir("templates")
+    return [
+        part
+        for path in sorted(templates.rglob("*"))
+        if path.is_file()
+        for part in (path.relative_to(templates).as_posix().encode(), path.read_bytes())
+    ]
+
+
+def emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes]:
+    """The emit stage, reusing the files of an earlier build of an identical model. Emitters
+    are pure functions of the model and the templates, so a hit runs no emitter (a warm
+    rebuild does not even import pxr)."""
+    return cached_stage(
+        cache,
+        "emit",
+        [digest(robot).encode(), *_template_bytes()],
+        lambda: emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)}),
+        _pack_files,
+        _unpack_files,
+        EMIT_LIBRARIES,
+        {"usd_format": usd_format},
+    )
+
+
+def simulate_cached(kit_dir: Path, robot: Robot, cache: Cache) -> dict[str, bytes]:
+    """The simulate stage on the staged kit, then the report emitters. The staged files are
+    a pure function of the model, so the model's digest (and the templates) keys both."""
+    return cached_stage(
+        cache,
+        "simulate",
+        [digest(robot).encode(), *_template_bytes()],
+        lambda: emit_reports(robot, simulate_all(kit_dir, robot)),
+        _pack_files,
+        _unpack_files,
+        (*EMIT_LIBRARIES, *SIMULATE_LIBRARIES),
+    )
 
 
 def write_tree(root: Path, files: dict[str, bytes]) -> None:
@@ -151,13 +172,20 @@ def build(
     cache = Cache.at() if cache is None else cache
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
-    files = _emit_cached(robot, usd_format, cache)
+    files = emit_cached(robot, usd_format, cache)
     out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
     staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))
     try:
         staged_kit = staging / kit_name
         write_tree(staged_kit, files)
+        say("simulate")
+        reports = simulate_cached(staged_kit, robot, cache)
+        clash = sorted(set(files) & set(reports))
+        if clash:
+            raise RuntimeError(f"a model emitter and a report emitter both write {clash[0]}")
+        write_tree(staged_kit, reports)
+        files = dict(sorted({**files, **reports}.items()))
         staged_zip = staging / layout.zip_name(robot.name)
         staged_zip.write_bytes(zip_bytes(files, kit_name))
         findings: list[Finding] = []

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import asdict
 from pathlib import Path
 
 from simkit.check.findings import Finding, require
@@ -19,6 +20,7 @@ from simkit.check.published_numbers import check_published
 from simkit.check.ros import check_ros
 from simkit.check.urdf import check_urdf
 from simkit.check.usd import check_usd
+from simkit.kitio.cache import Cache, cached_stage, decode_json, encode_json
 
 Check = Callable[[Kit], list[Finding]]
 
@@ -55,23 +57,23 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
 CHECK_LIBRARIES = ("numpy", "scipy", "mujoco", "yourdfpy", "trimesh", "usd-core", "manifold3d")
 
 
-def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache) -> list[Finding]:
+def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache: Cache) -> list[Finding]:
     """`run_checks`, reusing the findings of an earlier build whose kit was byte-identical.
 
     Checks are a pure function of the kit's bytes, simkit's code and the libraries that read
-    them, so those make the content-addressed key (issue 3: a warm rebuild re-runs no slow
-    pure step). Only passing results are stored; `simkit check` never uses the cache.
+    them, so those make the content-addressed key. Only passing results are stored;
+    `simkit check` never uses the cache.
     """
-    from dataclasses import asdict
-
-    from simkit.kitio.cache import code_digest, decode_json, encode_json, make_key
-
-    inputs = [part for path in sorted(files) for part in (path.encode("utf-8"), files[path])]
-    key = make_key("checks", 1, inputs, {"code": code_digest()}, CHECK_LIBRARIES)
-    stored = cache.get("checks", key)
-    if stored is not None:
-        return [Finding(**item) for item in decode_json(stored["findings"])]
-    findings = run_checks(kit_dir)
-    if all(f.ok for f in findings):
-        cache.put("checks", key, {"findings": encode_json([asdict(f) for f in findings])})
-    return findings
+    return cached_stage(
+        cache,
+        "checks",
+        [part for path in sorted(files) for part in (path.encode("utf-8"), files[path])],
+        lambda: run_checks(kit_dir),
+        lambda found: (
+            {"findings": encode_json([asdict(f) for f in found])}
+            if all(f.ok for f in found)
+            else None
+        ),
+        lambda stored: [Finding(**item) for item in decode_json(stored["findings"])],  # type: ignore[union-attr]
+        CHECK_LIBRARIES,
+    )

@@ -39,7 +39,10 @@ def check_freefall(kit: Kit) -> list[Finding]:
     findings.append(compare("freefall.samples", "CSV sample times", expected_t, times, 1e-9, "s"))
     if times.shape != expected_t.shape:
         return findings
-    runs, _, _ = freefall.mujoco_runs(kit, record["q0"], record["duration"])
+    armature = [(j["name"], j["armature"]) for j in kit.joints]
+    runs, _, _ = freefall.mujoco_runs(
+        kit.path(kit.mjcf), kit.path(kit.urdf), armature, record["q0"], record["duration"]
+    )
     for run in freefall.RUNS:
         sides = {
             "independent": np.column_stack([columns[f"{run}.independent.{j}"] for j in joints]),

@@ -16,8 +16,8 @@ import numpy as np
 
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
-from simkit.derive.benchmark import inverse_dynamics_model, kit_model_check
 from simkit.model.kinematics import axis_angle, rpy_matrix, transform
+from simkit.simulate.benchmark import inverse_dynamics_model, kit_model_check
 
 N_CASES = 12  # kit page: "It holds twelve cases"
 TCP_TOL = 1e-4  # m: the trajectory passes through the six TCP points within 0.1 mm

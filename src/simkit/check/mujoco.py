@@ -3,15 +3,12 @@ with robot.json, and with the published numbers."""
 
 from __future__ import annotations
 
-import re
-import tempfile
-from pathlib import Path
-
 import mujoco
 import numpy as np
 
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
+from simkit.simulate.loaders import load_urdf_file
 
 N_RANDOM = 25
 HOLD_SECONDS = 2.0
@@ -31,22 +28,8 @@ def load_control_mjcf(kit: Kit) -> mujoco.MjModel:
 
 
 def load_urdf_in_mujoco(kit: Kit) -> mujoco.MjModel:
-    """Compile the URDF in MuJoCo, keeping fixed frames as bodies and the relative mesh paths
-    (MuJoCo's URDF reader strips directories unless told not to)."""
-    urdf = kit.path(kit.urdf)
-    text = urdf.read_text(encoding="utf-8")
-    ext = '<mujoco><compiler strippath="false" fusestatic="false" discardvisual="true"/></mujoco>'
-    text = re.sub(r"(<robot\b[^>]*>)", r"\1" + ext, text, count=1)
-    # mesh paths made absolute, so the copy can live outside the kit (which may be read-only)
-    text = re.sub(
-        r'filename="([^"]+)"',
-        lambda m: f'filename="{(urdf.parent / m.group(1)).resolve().as_posix()}"',
-        text,
-    )
-    with tempfile.TemporaryDirectory(prefix="simkit-check-") as tmp:
-        copy = Path(tmp) / urdf.name
-        copy.write_text(text, encoding="utf-8")
-        return mujoco.MjModel.from_xml_path(str(copy))
+    """The kit's URDF compiled in MuJoCo (`simulate.loaders.load_urdf_file`)."""
+    return load_urdf_file(kit.path(kit.urdf))
 
 
 def _qpos_indices(model: mujoco.MjModel, names: list[str]) -> list[int]:

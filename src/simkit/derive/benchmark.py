@@ -13,14 +13,12 @@ from __future__ import annotations
 
 import itertools
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
 
 from simkit.derive import motion
 from simkit.kitio import layout
-from simkit.kitio.fmt import vec
 from simkit.model import ik
 from simkit.model.robot import Robot
 
@@ -36,7 +34,6 @@ ACCELERATION_FRACTION = 0.8
 TOOL_ROTATION = np.diag([1.0, -1.0, -1.0])
 POINTS = ("A_low", "A_high", "B_high", "B_low")
 SEQUENCE = ("A_low", "A_high", "B_high", "B_low", "B_high", "A_high", "A_low")
-PAYLOAD_BODY = "simkit_payload"
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,63 +156,6 @@ def cycle(robot: Robot, arm: ik.ArmChain, name: str, payload: float) -> Cycle:
     return Cycle(name, payload, acc, waypoints, tuple(n * DT for n in steps), t, q, qd, qdd, tcp)
 
 
-def inverse_dynamics_model(mjcf_text: str, parent_body: str, payload: dict):
-    """The kit's MJCF with its geometry left out (contacts play no part; every body has an
-    explicit inertial) and the payload attached to `parent_body` as one body."""
-    import mujoco
-
-    root = ET.fromstring(mjcf_text)
-    for parent in list(root.iter()):
-        for child in list(parent):
-            if child.tag == "geom" or (child.tag == "mesh" and parent.tag == "asset"):
-                parent.remove(child)
-    body = next(b for b in root.iter("body") if b.get("name") == parent_body)
-    if payload["mass"] > 0:
-        holder = ET.SubElement(body, "body", name=PAYLOAD_BODY, pos=vec(payload["com_link"]))
-        ET.SubElement(
-            holder,
-            "inertial",
-            pos="0 0 0",
-            mass=vec([payload["mass"]]),
-            diaginertia=vec(payload["inertia_diag"]),
-        )
-    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
-    return model
-
-
-def kit_model_check(
-    mjcf_text: str,
-    joints: list[str],
-    parent_body: str,
-    payload: dict,
-    q: np.ndarray,
-    qd: np.ndarray,
-    qdd: np.ndarray,
-) -> dict:
-    """Largest |torque| (N m) each joint of the MJCF needs to follow (q, qd, qdd) with the
-    payload (MuJoCo inverse dynamics: mass matrix, bias, damping), and its fraction of the
-    actuator's forcerange."""
-    import mujoco
-
-    model = inverse_dynamics_model(mjcf_text, parent_body, payload)
-    data = mujoco.MjData(model)
-    qadr = [int(model.jnt_qposadr[model.joint(n).id]) for n in joints]
-    dadr = [int(model.jnt_dofadr[model.joint(n).id]) for n in joints]
-    peak = np.zeros(len(joints))
-    for row in range(len(q)):
-        data.qpos[qadr], data.qvel[dadr], data.qacc[dadr] = q[row], qd[row], qdd[row]
-        mujoco.mj_inverse(model, data)
-        peak = np.maximum(peak, np.abs(data.qfrc_inverse[dadr]))
-    limit = np.array([float(model.actuator(n).forcerange[1]) for n in joints])
-    return {
-        "joints": joints,
-        "max_torque": list(peak),
-        "forcerange": list(limit),
-        "fraction": list(peak / limit),
-    }
-
-
 def payload_on_link(arm: ik.ArmChain, mass: float) -> dict:
     """The payload model plus its CoM in link 6's frame (for attaching it in MuJoCo)."""
     out = motion.payload_model(mass)
@@ -224,8 +164,9 @@ def payload_on_link(arm: ik.ArmChain, mass: float) -> dict:
     return out
 
 
-def benchmarks_block(robot: Robot, arm: ik.ArmChain, cycles: list[Cycle], checks: dict) -> dict:
-    """robot.json `benchmarks`."""
+def benchmarks_block(robot: Robot, arm: ik.ArmChain, cycles: list[Cycle]) -> dict:
+    """robot.json `benchmarks`; `kit_model_check` and `rated_cycle_torque` are filled by the
+    simulate stage (MuJoCo inverse dynamics on the written MJCF)."""
     names = list(arm.names)
     return {
         "path": {
@@ -269,17 +210,9 @@ def benchmarks_block(robot: Robot, arm: ik.ArmChain, cycles: list[Cycle], checks
             }
         },
         # kit page: the most torque each joint of the kit's MuJoCo model needs to follow the
-        # trajectory (the 1 kg files), as a fraction of its force limit
-        "kit_model_check": {
-            **checks["cycle_1kg"],
-            "trajectory": layout.benchmark(robot.name, "csv"),
-        },
-        "rated_cycle_torque": {
-            **checks["cycle_rated"],
-            "note": "the same inverse dynamics for the rated-payload cycle, which has no "
-            "trajectory file; the 80 % rule at the cycle poses does not bound the coupling "
-            "between joints, so a fraction may exceed 1",
-        },
+        # trajectory (the 1 kg files), as a fraction of its force limit: simulate/benchmark.py
+        "kit_model_check": None,
+        "rated_cycle_torque": None,
         "notes": [
             "cycle times are computed by this model; the reference page does not give the "
             "published cycle times",

@@ -188,10 +188,8 @@ def first_contacts(
 
 
 def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
-    """Adjacent and never-in-contact link pairs into `derived["collision_pairs"]` and
-    robot.json `collision_pairs`; the seed is the spec's."""
-    from simkit.derive.steps import with_json
-
+    """Adjacent and never-in-contact link pairs (`products.collision_pairs`: the SRDF and
+    robot.json `collision_pairs`); the seed is the spec's."""
     seed = robot.seed
     adjacent = adjacent_pairs(robot)
     first = first_contacts(robot, configurations(robot, seed, samples), adjacent)
@@ -204,6 +202,5 @@ def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
         "never": [list(p) for p, index in first.items() if index is None],
         "first_contact": {f"{a} {b}": i for (a, b), i in first.items() if i is not None},
     }
-    seeds = {**robot.derived.get("seeds", {}), "collision_pairs": seed}
-    robot = replace(robot, derived={**robot.derived, "collision_pairs": block, "seeds": seeds})
-    return with_json(robot, "collision_pairs", block)
+    seeds = {**robot.products.seeds, "collision_pairs": seed}
+    return replace(robot, products=replace(robot.products, collision_pairs=block, seeds=seeds))

@@ -10,13 +10,10 @@ everything it moves), at the stretched pose with the rated payload (and, in
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
-from simkit.derive import ik_cases
-from simkit.kitio import layout
-from simkit.model import dynamics, ik
+from simkit.model import dynamics
 from simkit.model.ik import ArmChain
 from simkit.model.robot import Robot
 
@@ -168,83 +165,3 @@ def motion_block(robot: Robot, arm: ArmChain) -> tuple[dict, dict]:
         "rosieos_settings_note": "no RosieOS planning settings are published for this robot",
     }
     return block, per_joint
-
-
-def derive_motion(robot: Robot) -> Robot:
-    """Derive step for a wrist-partitioned 6R arm (`ik.arm_chain`); any other robot is
-    returned unchanged. Adds the IK reference cases (`ik_reference`, ik_cases.json); with
-    torques, speeds and the stretched and work poses, the accelerations (`motion`,
-    joints[].derived_max_acceleration); with servos on every joint, the benchmark cycles
-    (`benchmarks`, the 1 kg trajectory).
-
-    Runs after the servos are derived: the benchmark's inverse-dynamics check reads the
-    MJCF that the final model emits."""
-    arm = ik.arm_chain(robot)
-    if arm is None:
-        return robot
-    robot = _derive_ik_cases(robot, arm)
-    joints = [robot.joint(n) for n in arm.names]
-    if any(j.effort_peak is None or j.max_velocity is None for j in joints):
-        return robot
-    if not {"stretched", "work"} <= dict(robot.poses).keys():
-        return robot
-    robot = _derive_accelerations(robot, arm)
-    if {a.joint for a in robot.actuators} >= set(arm.names):
-        robot = _derive_benchmark(robot, arm)
-    return robot
-
-
-def _derive_ik_cases(robot: Robot, arm: ArmChain) -> Robot:
-    from simkit.derive.steps import with_json  # derive imports this module
-
-    cases = ik_cases.cases_document(robot, arm)
-    seeds = {**robot.derived.get("seeds", {}), "ik_cases": robot.seed}
-    robot = replace(robot, derived={**robot.derived, "ik_cases": cases, "seeds": seeds})
-    reference = {
-        "file": layout.IK_CASES,
-        "cases": len(cases["cases"]),
-        "chain": {"base": arm.base, "tip": arm.tool, "joints": list(arm.names)},
-        "solver": {k: cases["solver"][k] for k in ("name", "method", "provenance")},
-        "branch_flags": ik.BRANCH_FLAGS,
-        "tolerance": ik_cases.TOLERANCE,
-    }
-    return with_json(robot, "ik_reference", reference)
-
-
-def _derive_accelerations(robot: Robot, arm: ArmChain) -> Robot:
-    from simkit.derive.steps import with_json  # derive imports this module
-
-    block, per_joint = motion_block(robot, arm)
-    joint_json = {**robot.derived.get("joint_json", {})}
-    for name, extra in per_joint.items():
-        joint_json[name] = {**joint_json.get(name, {}), **extra}
-    robot = replace(robot, derived={**robot.derived, "joint_json": joint_json})
-    return with_json(robot, "motion", block)
-
-
-def _derive_benchmark(robot: Robot, arm: ArmChain) -> Robot:
-    # benchmark and derive import this module; the emitter package imports every emitter
-    from simkit.derive import benchmark
-    from simkit.derive.steps import with_json
-    from simkit.emit import mjcf
-
-    cycles = [
-        benchmark.cycle(robot, arm, "cycle_1kg", WORK_PAYLOAD),
-        benchmark.cycle(robot, arm, "cycle_rated", rated_payload(robot)),
-    ]
-    text = mjcf.emit(robot)[layout.mjcf(robot.name)].decode("utf-8")
-    checks = {
-        c.name: benchmark.kit_model_check(
-            text,
-            list(arm.names),
-            arm.children[5],
-            benchmark.payload_on_link(arm, c.payload),
-            c.q,
-            c.qd,
-            c.qdd,
-        )
-        for c in cycles
-    }
-    trajectory = benchmark.trajectory_data(robot, arm, cycles[0])
-    robot = replace(robot, derived={**robot.derived, "benchmark_trajectory": trajectory})
-    return with_json(robot, "benchmarks", benchmark.benchmarks_block(robot, arm, cycles, checks))

@@ -244,14 +244,14 @@ def derive_collision(
     )
     geometry = [{"name": link.name, "collision": link.collision_report} for link in links]
     uses_coacd = any(link.collision_report.get("method") == "coacd" for link in links)
-    seeds = {**robot.derived.get("seeds", {}), **({"coacd": robot.seed} if uses_coacd else {})}
-    derived = {
-        **robot.derived,
-        "geometry_links": geometry,
-        "geometry_collision": _description(),
-        "seeds": seeds,
-    }
-    return replace(robot, links=links, derived=derived)
+    seeds = {**robot.products.seeds, **({"coacd": robot.seed} if uses_coacd else {})}
+    products = replace(
+        robot.products,
+        geometry_links=geometry,
+        geometry_collision=_description(),
+        seeds=seeds,
+    )
+    return replace(robot, links=links, products=products)
 
 
 def _store(

@@ -23,16 +23,16 @@ from simkit.emit import (
     urdf,
     usd,
 )
-from simkit.model.robot import Robot
+from simkit.model.robot import Robot, SimReports
 
 Emitter = Callable[[Robot], dict[str, bytes]]
+ReportEmitter = Callable[[Robot, SimReports], dict[str, bytes]]
 
 EMITTERS: dict[str, Emitter] = {
     "meshes": meshes.emit,
     "urdf": urdf.emit,
     "mjcf": mjcf.emit,
     "mjcf_scene": mjcf_scene.emit,
-    "robot_json": robot_json.emit,
     "docs": docs.emit,
     "srdf": srdf.emit,
     "ros2": ros2.emit,
@@ -41,16 +41,32 @@ EMITTERS: dict[str, Emitter] = {
     "motion_files": motion_files.emit,
     "glb": glb.emit,
     "ros2_control": ros2_control.emit,
+}
+
+
+#: Emitters of what the simulate stage measured: they run after it, on its reports.
+REPORT_EMITTERS: dict[str, ReportEmitter] = {
+    "robot_json": robot_json.emit,
     "freefall_files": freefall_files.emit,
 }
 
 
 def emit_all(robot: Robot, emitters: dict[str, Emitter] | None = None) -> dict[str, bytes]:
-    """Run every emitter; two emitters writing the same path is a bug, so it raises."""
+    """Run every model emitter (before the simulate stage)."""
+    return _collect({name: emitter(robot) for name, emitter in (emitters or EMITTERS).items()})
+
+
+def emit_reports(robot: Robot, reports: SimReports) -> dict[str, bytes]:
+    """Run every report emitter (after the simulate stage)."""
+    return _collect({name: emit(robot, reports) for name, emit in REPORT_EMITTERS.items()})
+
+
+def _collect(outputs: dict[str, dict[str, bytes]]) -> dict[str, bytes]:
+    """Merge emitter outputs, sorted by path; two emitters writing one path is a bug."""
     files: dict[str, bytes] = {}
     owner: dict[str, str] = {}
-    for name, emitter in (emitters or EMITTERS).items():
-        for path, data in emitter(robot).items():
+    for name, produced in outputs.items():
+        for path, data in produced.items():
             if path in files:
                 raise RuntimeError(f"emitters '{owner[path]}' and '{name}' both write {path}")
             files[path] = data

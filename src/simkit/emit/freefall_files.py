@@ -11,7 +11,7 @@ import io
 
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
-from simkit.model.robot import Robot
+from simkit.model.robot import Robot, SimReports
 
 STYLE = {  # side -> (label, matplotlib line style): three curves on top of each other
     "independent": ("independent (RNEA + solve_ivp)", {"color": "0.6", "linewidth": 5.0}),
@@ -69,11 +69,11 @@ def plot_png(robot: Robot, data: dict) -> bytes:
     return buffer.getvalue()
 
 
-def emit(robot: Robot) -> dict[str, bytes]:
+def emit(robot: Robot, reports: SimReports) -> dict[str, bytes]:
     """`validation/freefall.csv` and `validation/freefall.png` for a spec with `freefall:`."""
-    data = robot.derived.get("freefall")
-    if data is None:
+    if reports.freefall is None:
         return {}
+    data = reports.freefall["data"]
     return {
         layout.freefall_csv(): csv_text(data).encode("utf-8"),
         layout.freefall_plot(): plot_png(robot, data),

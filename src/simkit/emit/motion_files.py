@@ -1,6 +1,6 @@
 """Motion-data files of an arm kit: ik_cases.json, the 1 kg benchmark cycle (CSV and JSON)
 and examples/fk_ik.py. They format what the motion derive step (`motion.derive_motion`)
-put in `robot.derived`; a robot without those products gets none of these files.
+put in `robot.products`; a robot without those products gets none of these files.
 
 Source: 000_5f76ade803e16979.txt, "What a kit contains", "Benchmark cycle" and "IK reference
 cases".
@@ -74,11 +74,11 @@ def fk_ik_script(robot: Robot, base: str) -> bytes:
 def emit(robot: Robot) -> dict[str, bytes]:
     """`ik_cases.json`, `benchmark/NAME_cycle_1kg.{csv,json}` and `examples/fk_ik.py`."""
     out: dict[str, bytes] = {}
-    cases = robot.derived.get("ik_cases")
+    cases = robot.products.ik_cases
     if cases is not None:
         out[layout.IK_CASES] = dumps(cases)
         out[layout.example(FK_IK)] = fk_ik_script(robot, cases["chain"]["base"])
-    traj = robot.derived.get("benchmark_trajectory")
+    traj = robot.products.benchmark_trajectory
     if traj is not None:
         out[layout.benchmark(robot.name, "csv")] = trajectory_csv(traj)
         out[layout.benchmark(robot.name, "json")] = trajectory_json(traj)

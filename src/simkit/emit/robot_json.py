@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import math
-from importlib import metadata
 
 from simkit import __version__
-from simkit.derive import inertia_decision
 from simkit.derive.solids import CIRCULAR_SEGMENTS
 from simkit.emit import mjcf_world
 from simkit.kitio import layout
+from simkit.kitio.cache import library_versions
 from simkit.kitio.jsonout import dumps
-from simkit.model.robot import Joint, Link, Robot
+from simkit.model.robot import InertiaDecision, Joint, Link, Robot, SimReports
 
 LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core")
 
@@ -83,7 +82,7 @@ def _link(link: Link) -> dict:
     if link.note:
         out["note"] = link.note
     if link.inertia_decision is not None:  # kept non-physical inertia: recorded, never silent
-        out["inertia_decision"] = inertia_decision.record(link.inertia_decision)
+        out["inertia_decision"] = _decision(link.inertia_decision)
     return out
 
 
@@ -106,21 +105,13 @@ def _frames(robot: Robot) -> dict:
     return frames
 
 
-def _versions() -> dict:
-    out = {}
-    for name in LIBRARIES:
-        try:
-            out[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            out[name] = None
-    return out
-
-
-def document(robot: Robot) -> dict:
-    """The robot.json content as plain data (other emitters extend it via `robot.derived`)."""
+def document(robot: Robot, reports: SimReports) -> dict:
+    """The robot.json content as plain data: the one place that decides its keys and their
+    order, from the model, the derive products and the simulate stage's reports."""
+    products = robot.products
     published = robot.published
     poses = {name: list(q) for name, q in robot.poses}
-    geometric = robot.derived.get("reach_geometric")
+    geometric = products.reach_geometric
     doc: dict = {
         "name": robot.name,
         "title": robot.title,
@@ -131,12 +122,10 @@ def document(robot: Robot) -> dict:
             "mjcf": layout.mjcf(robot.name),
             "glb": layout.glb(robot.name),
         },
-        "base_frame": robot.derived.get("base_frame", robot.root),
+        "base_frame": products.base_frame or robot.root,
         "tool_frame": robot.tool_frame,
         "wrist_centre": robot.wrist_centre,
-        "joints": [
-            _joint(j, robot.derived.get("joint_json", {}).get(j.name)) for j in robot.movable_joints
-        ],
+        "joints": [_joint(j, products.joint_motion.get(j.name)) for j in robot.movable_joints],
         "fixed_joints": [
             {
                 "name": j.name,
@@ -152,7 +141,7 @@ def document(robot: Robot) -> dict:
         "frames": _frames(robot),
         "home": poses.get("home"),
         "poses": poses,
-        "fk_reference": robot.derived.get("fk_reference", []),
+        "fk_reference": products.fk_reference,
         "reach": {
             "published": {
                 "wrist": published.get("reach_wrist"),
@@ -175,8 +164,8 @@ def document(robot: Robot) -> dict:
             "plain envelopes",
             "mass_properties": "CoM and inertia of the solid at uniform density scaled to the "
             "link mass, unless the spec gives them",
-            "collision": robot.derived.get("geometry_collision"),
-            "links": robot.derived.get("geometry_links", []),
+            "collision": products.geometry_collision,
+            "links": products.geometry_links,
         },
         "actuators": [
             {
@@ -192,15 +181,50 @@ def document(robot: Robot) -> dict:
             "spec": robot.spec_file,
             "spec_sha256": robot.spec_sha256,
             "simkit_version": __version__,
-            "libraries": _versions(),
-            "seeds": {"spec": robot.seed, **robot.derived.get("seeds", {})},
+            "libraries": library_versions(LIBRARIES),
+            "seeds": {"spec": robot.seed, **products.seeds},
             "sources": list(robot.sources),
             "published_estimated": list(robot.published_estimated),
         },
     }
     _generalise(robot, doc)
-    doc.update(robot.derived.get("robot_json", {}))
+    doc.update(_products(robot, reports))
     return doc
+
+
+def _products(robot: Robot, reports: SimReports) -> dict:
+    """The top-level entries that derive steps and the simulate stage produce, in a fixed
+    order; absent products leave their key out."""
+    p = robot.products
+    out = {
+        "ros2_control": p.ros2_control,
+        "collision_pairs": p.collision_pairs,
+        "ik_reference": p.ik_reference,
+        "motion": p.motion,
+        "benchmarks": _benchmarks(robot, reports),
+        "validation": {"freefall": reports.freefall["record"]} if reports.freefall else None,
+    }
+    return {key: value for key, value in out.items() if value is not None}
+
+
+def _benchmarks(robot: Robot, reports: SimReports) -> dict | None:
+    """`benchmarks` with the simulate stage's inverse dynamics on the kit's MJCF filled in."""
+    block, torques = robot.products.benchmarks, reports.benchmark_torques
+    if block is None or torques is None:
+        return block
+    return {
+        **block,  # keeps its key order: the two entries below replace placeholders
+        "kit_model_check": {
+            **torques["cycle_1kg"],
+            "trajectory": layout.benchmark(robot.name, "csv"),
+        },
+        "rated_cycle_torque": {
+            **torques["cycle_rated"],
+            "note": "the same inverse dynamics for the rated-payload cycle, which has no "
+            "trajectory file; the 80 % rule at the cycle poses does not bound the coupling "
+            "between joints, so a fraction may exceed 1",
+        },
+    }
 
 
 def _generalise(robot: Robot, doc: dict) -> None:
@@ -209,7 +233,7 @@ def _generalise(robot: Robot, doc: dict) -> None:
     MJCF sensors where the spec has them. Arm kits are unchanged."""
     if not (robot.wrist_centre or robot.tool_frame):
         doc.pop("fk_reference")
-        if not robot.derived.get("reach_geometric") and not doc["reach"]["published"]["wrist"]:
+        if not robot.products.reach_geometric and not doc["reach"]["published"]["wrist"]:
             doc.pop("reach")
     if doc["payload"]["rated"] is None:
         doc.pop("payload")
@@ -233,6 +257,20 @@ def _generalise(robot: Robot, doc: dict) -> None:
         doc["sensors"] = [s.model_dump(exclude_none=True) for s in robot.mjcf.sensors]
 
 
-def emit(robot: Robot) -> dict[str, bytes]:
-    """`robot.json`."""
-    return {layout.ROBOT_JSON: dumps(document(robot))}
+def emit(robot: Robot, reports: SimReports) -> dict[str, bytes]:
+    """`robot.json` (a report emitter: it runs after the simulate stage)."""
+    return {layout.ROBOT_JSON: dumps(document(robot, reports))}
+
+
+def _decision(decision: InertiaDecision) -> dict:
+    """The decision as robot.json writes it next to the link."""
+    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    return {
+        "action": decision.action,
+        "reason": decision.reason,
+        "problem": decision.problem,
+        "reported": dict(zip(keys, decision.reported, strict=True)),
+        "emitted": dict(zip(keys, decision.emitted, strict=True)) if decision.emitted else None,
+        "rule": "emitted = every principal moment set to their mean (MuJoCo balanceinertia); "
+        "mass and CoM as reported",
+    }

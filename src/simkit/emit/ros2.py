@@ -53,7 +53,7 @@ def _context(robot: Robot) -> dict:
     poses = forward(robot)
     points = np.array([pose[:3, 3] for pose in poses.values()])
     extent = float(np.max(np.linalg.norm(points, axis=1))) if len(points) else 1.0
-    extra = robot.derived.get("ros2_exec_depends", ())  # e.g. ros2_control packages
+    extra = robot.products.ros2_exec_depends  # e.g. ros2_control packages
     return {
         "spec": robot.spec_file,
         "title": robot.title,

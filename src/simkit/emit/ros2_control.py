@@ -18,8 +18,8 @@ steps 2-3 and section 5 step 1, in their ROS 2 / gz sim form:
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from dataclasses import replace
 
+from simkit.derive.ros2_control import controllers, joints
 from simkit.emit.docs import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
@@ -40,11 +40,6 @@ def _placeholder(robot: Robot) -> str:
     """The `<parameters>` path the URDF carries; gazebo.launch.py swaps in the installed path
     (xacro would resolve the same `$(find ...)` form)."""
     return f"$(find {layout.kit_dir_name(robot.name)})/{layout.CONTROLLERS_YAML}"
-
-
-def joints(robot: Robot) -> list[Joint]:
-    """The joints ros2_control drives: every actuated movable joint, in tree order."""
-    return [j for j in robot.movable_joints if j.actuated]
 
 
 def _home(robot: Robot) -> dict[str, float]:
@@ -113,70 +108,6 @@ def _transmission(robot: Robot, joint: Joint) -> ET.Element:
     ratio = joint.drive.gear_ratio if joint.drive is not None else 1.0
     sub(actuator, "mechanicalReduction").text = num(ratio)
     return el
-
-
-def controllers(robot: Robot) -> dict[str, list[str]]:
-    """Controller names by control mode (what gazebo.launch.py spawns)."""
-    rc = robot.ros2_control
-    names = [j.name for j in joints(robot)]
-    return {
-        "position": [f"{n}_position_controller" for n in names] if rc.position_pid else [],
-        "effort": [f"{n}_effort_controller" for n in names] if rc.effort_controllers else [],
-    }
-
-
-def exec_depends(robot: Robot) -> list[str]:
-    """ROS 2 packages the URDF's plugin, controllers.yaml and gazebo.launch.py need."""
-    rc = robot.ros2_control
-    if rc is None:
-        return []
-    out = {
-        "controller_manager",
-        "gz_ros2_control",
-        "joint_state_broadcaster",
-        "ros_gz_bridge",
-        "ros_gz_sim",
-    }
-    if rc.position_pid is not None:
-        out.add("pid_controller")
-    if rc.effort_controllers:
-        out.add("effort_controllers")
-    return sorted(out)
-
-
-def derive_ros2_control(robot: Robot) -> Robot:
-    """Derive step: the extra ROS 2 packages the package emitter (emit/ros2.py) must depend
-    on, and robot.json's `ros2_control` entry (files, controllers, gains, estimates)."""
-    from simkit.derive.steps import with_json  # derive imports this module
-
-    rc = robot.ros2_control
-    if rc is None:
-        return robot
-    merged = sorted(set(robot.derived.get("ros2_exec_depends", ())) | set(exec_depends(robot)))
-    robot = replace(robot, derived={**robot.derived, "ros2_exec_depends": merged})
-    pid = rc.position_pid
-    return with_json(
-        robot,
-        "ros2_control",
-        {
-            "files": {
-                "controllers": layout.CONTROLLERS_YAML,
-                "gazebo_launch": layout.GAZEBO_LAUNCH,
-            },
-            "hardware_plugin": rc.hardware_plugin,
-            "command_interfaces": list(rc.command_interfaces),
-            "state_interfaces": list(rc.state_interfaces),
-            "update_rate": rc.update_rate,
-            "controllers": controllers(robot),
-            "position_pid": None if pid is None else pid.model_dump(),
-            "transmissions": {
-                j.name: j.drive.gear_ratio if j.drive else 1.0 for j in joints(robot)
-            },
-            "gazebo_materials": dict(rc.gazebo_materials),
-            "default_control": rc.default_control,
-            "estimated": list(rc.estimated),
-        },
-    )
 
 
 def _double(value: float) -> str:

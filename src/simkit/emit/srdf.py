@@ -28,7 +28,7 @@ def planning_groups(robot: Robot) -> list[PlanningGroup]:
     movable = robot.movable_joints
     if not movable or robot.tool_frame is None:
         return []
-    base = robot.derived.get("base_frame", movable[0].parent)
+    base = robot.products.base_frame or movable[0].parent
     return [PlanningGroup(DEFAULT_GROUP, base, robot.tool_frame)]
 
 
@@ -87,7 +87,7 @@ def emit(robot: Robot) -> dict[str, bytes]:
             parent_frame=WORLD,
             child_link=child,
         )
-    pairs = robot.derived.get("collision_pairs", {})
+    pairs = robot.products.collision_pairs or {}
     disabled = [(a, b, "Adjacent") for a, b in pairs.get("adjacent", [])]
     disabled += [(a, b, "Never") for a, b in pairs.get("never", [])]
     for a, b, reason in sorted(disabled):

@@ -23,6 +23,7 @@ import zipfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -46,12 +47,7 @@ def default_dir() -> Path:
 
 def library_version(name: str) -> str:
     """Installed version of a distribution (part of every key that uses that library)."""
-    from importlib import metadata
-
-    try:
-        return metadata.version(name)
-    except metadata.PackageNotFoundError:
-        return "none"
+    return library_versions((name,))[name] or "none"
 
 
 def _canonical(value: object) -> object:
@@ -266,37 +262,69 @@ def digest(value: object) -> str:
     return h.hexdigest()
 
 
-def derived_step(robot, cache: Cache, name: str, step: Callable):
-    """Run `step(robot) -> robot` through the cache when it only adds or replaces JSON-exact
-    entries of `robot.derived` (else it just runs). Key: the whole input robot, simkit's
-    source, and the numeric libraries' versions."""
-    from dataclasses import replace
+T = TypeVar("T")
 
+
+def cached_stage(
+    cache: Cache,
+    step: str,
+    inputs: list[bytes],
+    compute: Callable[[], T],
+    encode: Callable[[T], Arrays | None],
+    decode: Callable[[Arrays], T],
+    libraries: tuple[str, ...] = (),
+    params: Mapping[str, object] | None = None,
+) -> T:
+    """The one wrapper every cached stage goes through: `compute()` unless an entry for the
+    same inputs exists. The key holds `inputs` (bytes), simkit's source digest (any code
+    change misses), the library versions and `params`. `encode` returns the arrays to store,
+    or None when a result must not be stored (e.g. failed checks); `decode` rebuilds the
+    value from a stored entry."""
     if not cache.enabled:
-        return step(robot)
-    key = make_key(
-        f"derived_{name}",
-        1,
-        [digest(robot).encode(), code_digest().encode()],
-        {},
-        ("numpy", "mujoco", "manifold3d"),
-    )
-    found = cache.get(f"derived_{name}", key)
+        return compute()
+    key = make_key(step, 1, [code_digest().encode(), *inputs], params or {}, libraries)
+    found = cache.get(step, key)
     if found is not None:
-        extra = _join(decode_json(found["derived"]), found)
-        return replace(robot, derived={**robot.derived, **extra})  # type: ignore[dict-item]
-    out = step(robot)
-    changed = {
-        k: v for k, v in out.derived.items() if k not in robot.derived or robot.derived[k] is not v
-    }
+        return decode(found)
+    value = compute()
+    arrays = encode(value)
+    if arrays is None:
+        return value
+    cache.put(step, key, arrays)
+    # what a later hit returns, so a cold and a warm build hand identical values (same types,
+    # e.g. float not numpy.float64) to the next stage and its cache keys
+    return decode(arrays)
+
+
+def encode_plain(value: object) -> Arrays | None:
+    """Plain data (dicts with str keys, lists, str, bool, int, float64, numpy arrays) as
+    cache arrays: a JSON skeleton plus one array per ndarray. None for anything JSON cannot
+    hold exactly (tuples, other objects), so such a value is simply not cached."""
     arrays: Arrays = {}
     try:
-        skeleton = _split(changed, arrays)
-        exact = json.loads(json.dumps(skeleton)) == skeleton
+        skeleton = _split(value, arrays)
+        if json.loads(json.dumps(skeleton)) != skeleton:
+            return None
     except (TypeError, ValueError):
-        exact = False
-    if exact and replace(out, derived=robot.derived) == robot:
-        cache.put(f"derived_{name}", key, {"derived": encode_json(skeleton), **arrays})
+        return None
+    return {"skeleton": encode_json(skeleton), **arrays}
+
+
+def decode_plain(arrays: Arrays) -> object:
+    """The value `encode_plain` stored."""
+    return _join(decode_json(arrays["skeleton"]), arrays)
+
+
+def library_versions(names: tuple[str, ...]) -> dict[str, str | None]:
+    """Installed version of each distribution, None when absent (robot.json provenance)."""
+    from importlib import metadata
+
+    out: dict[str, str | None] = {}
+    for name in names:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
     return out
 
 

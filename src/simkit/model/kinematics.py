@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from simkit.model.robot import Joint, Robot
+from simkit.spec.schema import depth_first
 
 
 def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
@@ -145,20 +146,8 @@ def pose_in(robot: Robot, q, target: str, base: str) -> np.ndarray:
 
 
 def tree_order(joints: Sequence[Joint], root: str) -> list[Joint]:
-    """Joints in depth-first order (each chain contiguous, as a reader of URDF or MJCF
-    expects); siblings keep spec order."""
-    by_parent: dict[str, list[Joint]] = {}
-    for joint in joints:
-        by_parent.setdefault(joint.parent, []).append(joint)
-    return _depth_first(by_parent, root)
-
-
-def _depth_first(by_parent: dict[str, list[Joint]], node: str) -> list[Joint]:
-    out: list[Joint] = []
-    for joint in by_parent.get(node, []):
-        out.append(joint)
-        out.extend(_depth_first(by_parent, joint.child))
-    return out
+    """Joints in depth-first order (`spec.schema.depth_first`): the model's joint order."""
+    return depth_first(joints, root)
 
 
 def chain(robot: Robot, base: str, tip: str) -> list[Joint]:
@@ -173,3 +162,10 @@ def chain(robot: Robot, base: str, tip: str) -> list[Joint]:
         out.append(joint)
         node = joint.parent
     return out[::-1]
+
+
+def jointed_pairs(robot: Robot) -> list[tuple[str, str]]:
+    """Parent-child link pairs joined directly by a joint, in joint order: the pairs whose
+    contacts the MJCF and USD exclude (MoveIt's wider `adjacent_pairs` is a derive step)."""
+    links = {link.name for link in robot.links}
+    return [(j.parent, j.child) for j in robot.joints if j.parent in links]

@@ -7,10 +7,28 @@ import math
 
 import numpy as np
 
-from simkit.derive.inertia_decision import decision_of
 from simkit.model.kinematics import matrix_rpy, tree_order
-from simkit.model.robot import Drive, Frame, Inertial, Joint, Link, PlanningGroup, Robot, Shape
-from simkit.spec.schema import CollisionPrimitive, DriveSpec, JointSpec, Primitive, RobotSpec
+from simkit.model.robot import (
+    Drive,
+    Frame,
+    InertiaDecision,
+    Inertial,
+    Joint,
+    Link,
+    PlanningGroup,
+    Robot,
+    Shape,
+)
+from simkit.spec.schema import (
+    CollisionPrimitive,
+    DriveSpec,
+    JointSpec,
+    LinkSpec,
+    Primitive,
+    RobotSpec,
+    angle,
+)
+from simkit.spec.validate import inertia_problem
 
 
 def _unit(v) -> tuple[float, float, float]:
@@ -79,10 +97,18 @@ def drive_peak_torque(drive: Drive) -> float:
     return torque
 
 
-def _angle(rad: float | None, deg: float | None) -> float | None:
-    if rad is not None:
-        return float(rad)
-    return math.radians(deg) if deg is not None else None
+def decision_of(link: LinkSpec) -> InertiaDecision | None:
+    """The model's record of a link's decision (resolve stage); None without one."""
+    decision, inertia = link.inertia_decision, link.inertia
+    if decision is None or inertia is None:
+        return None
+    reported = (inertia.ixx, inertia.iyy, inertia.izz, inertia.ixy, inertia.ixz, inertia.iyz)
+    return InertiaDecision(
+        action=decision.action,
+        reason=decision.reason,
+        reported=reported,
+        problem=inertia_problem(inertia) or "",
+    )
 
 
 def joint_of(spec: JointSpec) -> Joint:
@@ -100,9 +126,9 @@ def joint_of(spec: JointSpec) -> Joint:
         xyz=tuple(float(v) for v in spec.xyz),  # type: ignore[arg-type]
         rpy=spec.rpy_rad(),
         axis=_unit(spec.axis),
-        lower=_angle(spec.lower, spec.lower_deg),
-        upper=_angle(spec.upper, spec.upper_deg),
-        max_velocity=_angle(spec.max_velocity, spec.max_velocity_deg_s),
+        lower=angle(spec.lower, spec.lower_deg),
+        upper=angle(spec.upper, spec.upper_deg),
+        max_velocity=angle(spec.max_velocity, spec.max_velocity_deg_s),
         effort_peak=spec.effort_peak,
         effort_continuous=spec.effort_continuous,
         drive_peak_torque_at_joint=peak if peak is not None else spec.effort_peak,

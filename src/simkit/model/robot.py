@@ -186,6 +186,51 @@ class PlanningGroup:
 
 
 @dataclass(frozen=True)
+class Products:
+    """What the derive steps add that has no natural field on a link or joint. Each field has
+    exactly one writer (named below) and is read by emitters; robot.json's shape is decided
+    in one place, `emit/robot_json.py`. Values are plain data (dicts, lists, arrays), replaced
+    wholesale with `dataclasses.replace`, never mutated. None / empty: not derived."""
+
+    #: derive/references.py: FK reference poses, the frame they are expressed in, reach (m)
+    fk_reference: list = field(default_factory=list)
+    base_frame: str | None = None
+    reach_geometric: dict | None = None
+    #: derive/per_link.py: how collision pieces were made, per link and overall
+    geometry_links: list = field(default_factory=list)
+    geometry_collision: dict | None = None
+    #: every seeded step records its seed here (robot.json provenance.seeds), in step order
+    seeds: dict = field(default_factory=dict)
+    #: derive/ros2_control.py: robot.json `ros2_control` and the package's extra dependencies
+    ros2_control: dict | None = None
+    ros2_exec_depends: list = field(default_factory=list)
+    #: derive/collision_pairs.py: SRDF disabled pairs and robot.json `collision_pairs`
+    collision_pairs: dict | None = None
+    #: derive/arm.py: ik_cases.json and robot.json `ik_reference`
+    ik_cases: dict | None = None
+    ik_reference: dict | None = None
+    #: derive/arm.py: robot.json `motion` and per-joint additions (derived accelerations)
+    motion: dict | None = None
+    joint_motion: dict = field(default_factory=dict)
+    #: derive/arm.py: robot.json `benchmarks` (before the simulate stage adds its
+    #: inverse-dynamics figures), both cycles' samples, and the 1 kg trajectory files' data
+    benchmarks: dict | None = None
+    benchmark_cycles: dict = field(default_factory=dict)
+    benchmark_trajectory: dict | None = None
+
+
+@dataclass(frozen=True)
+class SimReports:
+    """What the simulate stage measured on the staged files (plain data). Only the report
+    emitters read it (robot.json, the validation files), after the simulate stage."""
+
+    #: simulate/freefall.py: {"record": robot.json validation.freefall, "data": trajectories}
+    freefall: dict | None = None
+    #: simulate/benchmark.py: {cycle name: inverse-dynamics torques and forcerange fractions}
+    benchmark_torques: dict | None = None
+
+
+@dataclass(frozen=True)
 class Robot:
     """The whole robot: links and joints in tree order (parents before children)."""
 
@@ -208,7 +253,7 @@ class Robot:
     spec_sha256: str
     spec_file: str
     actuators: tuple[Actuator, ...] = ()
-    derived: dict = field(default_factory=dict)
+    products: Products = field(default_factory=Products)
     planning_groups: tuple[PlanningGroup, ...] = ()
     #: MuJoCo scene settings (`spec_mjcf.MjcfSpec`, frozen), or None for simkit's defaults.
     mjcf: MjcfSpec | None = None

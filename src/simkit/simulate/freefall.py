@@ -20,13 +20,12 @@ all three sides: `rigid` (friction off everywhere: the rigid-body model, mountin
 and `friction` (the spec's friction on every side: MuJoCo's frictionloss against regularised
 Coulomb friction). Both must stay under the spec's RMS bound.
 
-The derive step runs all this on the files the emitters will write (emitted into a temporary
-folder); `check/freefall_check.py` runs the MuJoCo side again on the written kit.
+The simulate stage runs all this on the staged kit's MJCF and URDF; `check/freefall.py` runs
+the MuJoCo side again on the written kit and holds it to the recorded independent trajectory.
 """
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -34,8 +33,11 @@ import numpy as np
 
 from simkit.errors import SpecError
 from simkit.kitio import layout
+from simkit.kitio.cache import library_versions
+from simkit.kitio.fmt import rounded
 from simkit.model import rnea
 from simkit.model.robot import Robot
+from simkit.simulate.loaders import load_mjcf_file, load_urdf_file
 
 SAMPLE_DT = 0.01  # s: trajectories are compared, stored and plotted every 10 ms
 RUNS = ("rigid", "friction")
@@ -48,14 +50,16 @@ def sample_times(duration: float) -> np.ndarray:
     return np.arange(round(duration / SAMPLE_DT) + 1) * SAMPLE_DT
 
 
-def load_models(kit) -> dict:
-    """MuJoCo models of the kit's MJCF and URDF; the URDF one gets robot.json's armature."""
-    from simkit.check.mujoco import load_mjcf, load_urdf_in_mujoco
+Joints = list[tuple[str, float]]  # (name, armature in kg m^2) of every movable joint
 
-    models = {"mjcf": load_mjcf(kit), "urdf": load_urdf_in_mujoco(kit)}
-    urdf = models["urdf"]
-    for joint in kit.joints:
-        urdf.dof_armature[urdf.jnt_dofadr[urdf.joint(joint["name"]).id]] = joint["armature"]
+
+def load_models(mjcf: Path, urdf: Path, joints: Joints) -> dict:
+    """MuJoCo models of the kit's MJCF and URDF; the URDF one gets each joint's armature
+    (as robot.json publishes it: URDF has no armature element)."""
+    models = {"mjcf": load_mjcf_file(mjcf), "urdf": load_urdf_file(urdf)}
+    urdf_model = models["urdf"]
+    for name, armature in joints:
+        urdf_model.dof_armature[urdf_model.jnt_dofadr[urdf_model.joint(name).id]] = armature
     return models
 
 
@@ -125,32 +129,23 @@ def _independent(robot: Robot, q0, duration: float) -> dict[str, np.ndarray]:
     return out
 
 
-def _emit_to(robot: Robot, folder: Path) -> None:
-    """Write the files the MuJoCo side reads (MJCF, URDF, meshes, robot.json)."""
-    from simkit.emit import meshes, mjcf, robot_json, urdf
-
-    for emitter in (meshes.emit, mjcf.emit, urdf.emit, robot_json.emit):
-        for rel, data in emitter(robot).items():
-            target = folder.joinpath(*rel.split("/"))
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_bytes(data)
-
-
-def mujoco_runs(kit, q0, duration: float) -> tuple[dict, float, dict]:
+def mujoco_runs(
+    mjcf: Path, urdf: Path, joints: Joints, q0, duration: float
+) -> tuple[dict, float, dict]:
     """MuJoCo trajectories {run: {"mjcf": Q, "urdf": Q}}, the timestep used (the MJCF's), and
     the MJCF's own integrator name and rigid-run trajectory (informational)."""
     import mujoco
 
-    names = [j["name"] for j in kit.joints]
-    timestep = float(load_models(kit)["mjcf"].opt.timestep)
+    names = [name for name, _ in joints]
+    timestep = float(load_mjcf_file(mjcf).opt.timestep)
     runs: dict = {}
     for run in RUNS:
-        models = load_models(kit)
+        models = load_models(mjcf, urdf, joints)
         runs[run] = {
             side: simulate(models[side], names, q0, duration, timestep, friction=run == "friction")
             for side in ("mjcf", "urdf")
         }
-    own = load_models(kit)["mjcf"]
+    own = load_mjcf_file(mjcf)
     own.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_ACTUATION)
     own.dof_frictionloss[:] = 0.0
     integrator = mujoco.mjtIntegrator(int(own.opt.integrator)).name.removeprefix("mjINT_")
@@ -172,33 +167,24 @@ def figures(trajectories: dict) -> dict:
     return out
 
 
-def _versions(names: tuple[str, ...]) -> dict[str, str | None]:
-    from importlib import metadata
-
-    out: dict[str, str | None] = {}
-    for name in names:
-        try:
-            out[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            out[name] = None
-    return out
-
-
-def derive_freefall(robot: Robot) -> Robot:
-    """Run the three simulations for a spec with a `freefall:` section; the trajectories go to
-    `derived["freefall"]` (the validation emitter writes them) and the figures to robot.json
-    `validation.freefall`. A run over the bound is not an error here: the check fails."""
-    from simkit.check.kit import Kit
-    from simkit.derive.steps import with_json
-
+def run(kit_dir: Path, robot: Robot) -> dict | None:
+    """The three simulations for a spec with a `freefall:` section, on the staged kit:
+    {"record": robot.json `validation.freefall`, "data": what emit/freefall_files.py writes}.
+    None without the section. A run over the bound is not an error here: the check fails."""
     setup = robot.freefall
     if setup is None:
-        return robot
+        return None
     q0 = np.asarray(robot.pose(setup.pose), float)
     independent = _independent(robot, q0, setup.duration)
-    with tempfile.TemporaryDirectory(prefix="simkit-freefall-") as tmp:
-        _emit_to(robot, Path(tmp))
-        runs, timestep, own = mujoco_runs(Kit.open(Path(tmp)), q0, setup.duration)
+    # armature as robot.json publishes it (10 significant digits), as a URDF user reads it
+    joints = [(j.name, rounded(j.armature)) for j in robot.movable_joints]
+    runs, timestep, own = mujoco_runs(
+        kit_dir / layout.mjcf(robot.name),
+        kit_dir / layout.urdf(robot.name),
+        joints,
+        q0,
+        setup.duration,
+    )
     trajectories = {run: {"independent": independent[run], **runs[run]} for run in RUNS}
     numbers = figures(trajectories)
     worst = max(v["rms"] for run in numbers.values() for v in run.values())
@@ -235,20 +221,16 @@ def derive_freefall(robot: Robot) -> Robot:
             "rigid_rms_vs_independent": rms(own["rigid"], independent["rigid"]),
             "note": "informational: the MJCF's own integrator at its own timestep",
         },
-        "libraries": _versions(("scipy", "mujoco", "matplotlib")),
+        "libraries": library_versions(("scipy", "mujoco", "matplotlib")),
         "worst_rms": worst,
         "passed": worst < setup.tolerance_rms,
         "files": {"csv": layout.freefall_csv(), "plot": layout.freefall_plot()},
     }
-    derived = dict(
-        robot.derived,
-        freefall={
-            "t": sample_times(setup.duration),
-            "joints": names,
-            "trajectories": trajectories,
-            "figures": numbers,
-            "tolerance_rms": setup.tolerance_rms,
-        },
-    )
-    validation = dict(robot.derived.get("robot_json", {}).get("validation", {}), freefall=record)
-    return with_json(replace(robot, derived=derived), "validation", validation)
+    data = {
+        "t": sample_times(setup.duration),
+        "joints": names,
+        "trajectories": trajectories,
+        "figures": numbers,
+        "tolerance_rms": setup.tolerance_rms,
+    }
+    return {"record": record, "data": data}

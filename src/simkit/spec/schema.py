@@ -8,7 +8,8 @@ listed by field name in the entity's `estimated` list, and that list ends up in 
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from collections.abc import Sequence
+from typing import Annotated, Literal, Protocol, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -157,6 +158,38 @@ class DriveSpec(Strict):
     estimated: tuple[str, ...] = ()
 
 
+class Edge(Protocol):
+    """A joint seen as a tree edge: any object with `parent` and `child` link names."""
+
+    parent: str
+    child: str
+
+
+E = TypeVar("E", bound=Edge)
+
+
+def depth_first(joints: Sequence[E], root: str) -> list[E]:
+    """Joints in depth-first order from `root` (each chain contiguous, as a reader of URDF or
+    MJCF expects); siblings keep spec order. The model's joint order (`Robot.joints`)."""
+    by_parent: dict[str, list[E]] = {}
+    for joint in joints:
+        by_parent.setdefault(joint.parent, []).append(joint)
+    out: list[E] = []
+    stack = list(reversed(by_parent.get(root, [])))
+    while stack:  # iterative: a deep chain must not hit Python's recursion limit
+        joint = stack.pop()
+        out.append(joint)
+        stack.extend(reversed(by_parent.get(joint.child, [])))
+    return out
+
+
+def angle(rad: float | None, deg: float | None) -> float | None:
+    """A value given in rad (or m) or in degrees, in SI; None when neither is given."""
+    if rad is not None:
+        return float(rad)
+    return math.radians(deg) if deg is not None else None
+
+
 class JointSpec(Placed):
     """A joint between two links. `xyz`/`rpy` place the child frame in the parent frame."""
 
@@ -201,6 +234,15 @@ class JointSpec(Placed):
             if getattr(self, rad) is not None and getattr(self, deg) is not None:
                 raise ValueError(f"give {rad} or {deg}, not both")
         return self
+
+    @property
+    def movable(self) -> bool:
+        """One degree of freedom: has a value in every named pose."""
+        return self.type not in ("fixed", "floating")
+
+    def limits(self) -> tuple[float | None, float | None]:
+        """(lower, upper) in rad (m for prismatic joints)."""
+        return angle(self.lower, self.lower_deg), angle(self.upper, self.upper_deg)
 
     @field_validator("axis")
     @classmethod

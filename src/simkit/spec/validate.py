@@ -17,7 +17,7 @@ from simkit.errors import SpecError
 from simkit.spec import mjcf as spec_mjcf
 from simkit.spec import sim as spec_sim
 from simkit.spec.load import Loc, SourceDoc, dotted, load_yaml
-from simkit.spec.schema import InertiaSpec, RobotSpec
+from simkit.spec.schema import InertiaSpec, RobotSpec, depth_first
 
 Problem = tuple[Loc, str]
 
@@ -251,17 +251,15 @@ def validate(doc: SourceDoc) -> RobotSpec:
 def _pose_limits(spec: RobotSpec) -> Iterator[Problem]:
     """Every named pose lies within the joint limits. Pose values follow the model's joint
     order (depth-first, `resolve.py`), as `Robot.pose` reads them."""
-    from simkit.model.kinematics import tree_order
-    from simkit.model.resolve import joint_of
-
-    joints = [j for j in tree_order([joint_of(j) for j in spec.joints], spec.root) if j.movable]
+    joints = [j for j in depth_first(spec.joints, spec.root) if j.movable]
     for key, scale in (("poses", 1.0), ("poses_deg", math.pi / 180)):
         for pose, values in getattr(spec, key).items():
             for k, (joint, value) in enumerate(zip(joints, values, strict=True)):
-                if joint.type == "continuous" or joint.lower is None or joint.upper is None:
+                lower, upper = joint.limits()
+                if joint.type == "continuous" or lower is None or upper is None:
                     continue
                 q = value * scale
-                if not joint.lower - 1e-9 <= q <= joint.upper + 1e-9:
+                if not lower - 1e-9 <= q <= upper + 1e-9:
                     yield (
                         (key, pose, k),
                         f"pose '{pose}' puts {joint.name} at {value:g}"

@@ -1,4 +1,5 @@
-"""Recorded decisions to keep a reported inertia tensor that is not physical.
+"""Link mass properties: from the solid scaled to the link mass unless the spec gives them,
+and recorded decisions to keep a reported inertia tensor that is not physical.
 
 The ECN 2R report's link_0 (002_e760a3794accbbd5.txt, Appendix 1) has Ixx + Iyy < Izz, which
 no rigid body can have; MuJoCo refuses such a body and Gazebo's solvers misbehave. A spec may
@@ -14,25 +15,23 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from simkit.model.robot import InertiaDecision, Inertial, Robot
-from simkit.spec.schema import InertiaSpec, LinkSpec
+from simkit.model import inertia
+from simkit.model.robot import Inertial, Robot
+from simkit.spec.schema import InertiaSpec
 from simkit.spec.validate import inertia_problem
 
 Tensor6 = tuple[float, float, float, float, float, float]
 
 
-def decision_of(link: LinkSpec) -> InertiaDecision | None:
-    """The model's record of a link's decision (resolve stage); None without one."""
-    decision, inertia = link.inertia_decision, link.inertia
-    if decision is None or inertia is None:
-        return None
-    reported = (inertia.ixx, inertia.iyy, inertia.izz, inertia.ixy, inertia.ixz, inertia.iyz)
-    return InertiaDecision(
-        action=decision.action,
-        reason=decision.reason,
-        reported=reported,
-        problem=inertia_problem(inertia) or "",
+def derive_mass(robot: Robot) -> Robot:
+    """CoM and inertia from the solid scaled to the link mass, unless the spec gives them."""
+    links = tuple(
+        link
+        if link.inertial is not None
+        else replace(link, inertial=inertia.from_solid(link.solid, link.mass))
+        for link in robot.links
     )
+    return replace(robot, links=links)
 
 
 def balanced(tensor: Tensor6) -> Tensor6:
@@ -62,17 +61,3 @@ def derive_inertia_decisions(robot: Robot) -> Robot:
             replace(link, inertial=inertial, inertia_decision=replace(decision, emitted=emitted))
         )
     return replace(robot, links=tuple(links))
-
-
-def record(decision: InertiaDecision) -> dict:
-    """The decision as robot.json writes it next to the link."""
-    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
-    return {
-        "action": decision.action,
-        "reason": decision.reason,
-        "problem": decision.problem,
-        "reported": dict(zip(keys, decision.reported, strict=True)),
-        "emitted": dict(zip(keys, decision.emitted, strict=True)) if decision.emitted else None,
-        "rule": "emitted = every principal moment set to their mean (MuJoCo balanceinertia); "
-        "mass and CoM as reported",
-    }
