@@ -123,7 +123,8 @@ def test_warm_derive_hits_every_step_and_emits_the_same_bytes(tmp_path):
     assert warm == cold
     # a warm derive and emit import neither CoACD nor trimesh (issue 3: lazy imports)
     code = (
-        "import sys; from simkit.pipeline import model_from_spec; from simkit.kitio.cache import Cache; "
+        "import sys; from simkit.pipeline import model_from_spec; "
+        "from simkit.kitio.cache import Cache; "
         "from simkit.emit import emit_all; "
         f"emit_all(model_from_spec('rosie_1000', cache=Cache.at({str(tmp_path)!r}))); "
         "print(sorted(m for m in ('coacd', 'trimesh') if m in sys.modules))"

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from simkit.check.kit import Kit
+from simkit.check.readers.glb import read_glb
 from simkit.emit import glb
 from simkit.kitio.resources import robot_names
 from simkit.pipeline import model_from_spec
@@ -35,7 +36,7 @@ const validator = require('gltf-validator');
 
 
 def _read(path: Path) -> dict:
-    doc, _binary = glb.read_glb(path.read_bytes())
+    doc, _binary = read_glb(path.read_bytes())
     return doc
 
 
@@ -134,7 +135,7 @@ def test_tree_materials_and_positions(kit_factory):
     assert materials["red"] == [0.8, 0.2, 0.2, 1.0]
     mesh = doc["meshes"][nodes["bracket"]["mesh"]]["primitives"][0]
     assert doc["materials"][mesh["material"]]["name"] == "red"
-    _doc, binary = glb.read_glb((kit_dir / "glb" / "collision_mix.glb").read_bytes())
+    _doc, binary = read_glb((kit_dir / "glb" / "collision_mix.glb").read_bytes())
     accessor = doc["accessors"][mesh["attributes"]["POSITION"]]
     view = doc["bufferViews"][accessor["bufferView"]]
     positions = np.frombuffer(binary, "<f4", accessor["count"] * 3, view["byteOffset"]).reshape(

@@ -6,8 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from simkit.check.findings import Finding, compare, require
+from simkit.check.fk import fk_agrees
 from simkit.check.kit import Kit
 from simkit.check.mujoco import random_configs
+from simkit.check.readers.glb import read_glb
 from simkit.model.kinematics import axis_angle, quat_matrix, transform
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
@@ -118,7 +120,6 @@ def glb_world(doc: dict, q: dict[str, float]) -> dict[str, np.ndarray]:
 def check_glb(kit: Kit) -> list[Finding]:
     """The GLB parses, has a node per link, and its nodes rotated by seeded random joint
     values put the tool frame where robot.json's FK does."""
-    from simkit.emit.glb import read_glb
 
     rel = kit.doc.get("files", {}).get("glb", f"glb/{kit.name}.glb")
     path = kit.path(rel)
@@ -140,31 +141,11 @@ def check_glb(kit: Kit) -> list[Finding]:
     tool = kit.doc.get("tool_frame")
     if tool and tool in names and kit.joints:
         joint_names = [j["name"] for j in kit.joints]
-        errors, rot_errors = [], []
-        for q in random_configs(kit, 10, seed=2):
+
+        def tool_pose(q: np.ndarray) -> np.ndarray:
             world = glb_world(doc, dict(zip(joint_names, q, strict=True)))
-            pose = np.linalg.inv(world[kit.base_frame]) @ world[tool]
-            ref = kit.fk(q)
-            errors.append(pose[:3, 3] - ref[:3, 3])
-            rot_errors.append(pose[:3, :3] - ref[:3, :3])
-        findings.append(
-            compare(
-                "glb.fk",
-                f"{tool} from GLB nodes at 10 random configurations vs robot.json FK",
-                np.zeros((len(errors), 3)),
-                errors,
-                GLB_FK_TOL,
-                "m",
-            )
-        )
-        findings.append(
-            compare(
-                "glb.fk.rotation",
-                f"{tool} rotation, GLB vs robot.json",
-                np.zeros((len(rot_errors), 3, 3)),
-                rot_errors,
-                GLB_FK_TOL,
-                "",
-            )
-        )
+            return np.linalg.inv(world[kit.base_frame]) @ world[tool]
+
+        configs = random_configs(kit, 10, seed=2)
+        findings += fk_agrees(kit, "glb.fk", "GLB nodes", tool_pose, configs, GLB_FK_TOL)
     return findings

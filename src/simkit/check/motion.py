@@ -18,6 +18,7 @@ from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
 from simkit.model.kinematics import axis_angle, rpy_matrix, transform
 from simkit.simulate.benchmark import inverse_dynamics_model, kit_model_check
+from simkit.simulate.loaders import load_urdf_text
 
 N_CASES = 12  # kit page: "It holds twelve cases"
 TCP_TOL = 1e-4  # m: the trajectory passes through the six TCP points within 0.1 mm
@@ -147,6 +148,55 @@ def _payload(kit: Kit, payload: dict) -> dict:
     T = transform(frame["xyz"], rpy_matrix(frame["rpy"]))
     com = (T @ np.array([*payload["com_xyz"], 1.0]))[:3]
     return {**payload, "link": frame["parent"], "com_link": list(com)}
+
+
+def _urdf_with_payload(kit: Kit, payload: dict) -> mujoco.MjModel:
+    """The kit's URDF in MuJoCo with the payload as a fixed child link of its parent link,
+    robot.json's armature on every joint (URDF has no armature element), contacts off."""
+    com = " ".join(repr(float(v)) for v in payload["com_link"])
+    ixx, iyy, izz = (repr(float(v)) for v in payload["inertia_diag"])
+    extra = (
+        f'<link name="simkit_payload"><inertial><origin xyz="{com}" rpy="0 0 0"/>'
+        f'<mass value="{float(payload["mass"])!r}"/><inertia ixx="{ixx}" iyy="{iyy}" '
+        f'izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        f'<joint name="simkit_payload_joint" type="fixed"><parent link="{payload["link"]}"/>'
+        '<child link="simkit_payload"/></joint></robot>'
+    )
+    urdf = kit.path(kit.urdf)
+    text = urdf.read_text(encoding="utf-8")
+    head, sep, _ = text.rpartition("</robot>")
+    model = load_urdf_text(head + extra if sep else text, urdf)
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    for joint in kit.joints:
+        model.dof_armature[model.jnt_dofadr[model.joint(joint["name"]).id]] = joint["armature"]
+    return model
+
+
+def _urdf_inverse_dynamics(
+    kit: Kit, payload: dict, names: list[str], motion: tuple, recorded: list[float]
+) -> Finding:
+    """The independent path for `benchmarks.kit_model_check`: MuJoCo inverse dynamics on the
+    kit's URDF (another file, another emitter) along the 1 kg cycle, relative to the largest
+    recorded torque."""
+    model = _urdf_with_payload(kit, payload)
+    data = mujoco.MjData(model)
+    qadr = [int(model.jnt_qposadr[model.joint(n).id]) for n in names]
+    dadr = [int(model.jnt_dofadr[model.joint(n).id]) for n in names]
+    peak = np.zeros(len(names))
+    for q, qd, qdd in zip(*motion, strict=True):
+        data.qpos[qadr], data.qvel[dadr], data.qacc[dadr] = q, qd, qdd
+        mujoco.mj_inverse(model, data)
+        peak = np.maximum(peak, np.abs(data.qfrc_inverse[dadr]))
+    scale = max(max(recorded), 1e-9)
+    return compare(
+        "benchmark.urdf_inverse_dynamics",
+        "largest torque per joint along the 1 kg cycle: MuJoCo on the URDF vs robot.json "
+        "(relative to the largest)",
+        np.asarray(recorded) / scale,
+        peak / scale,
+        1e-6,
+        "",
+    )
 
 
 def _trajectory(kit: Kit, files: dict) -> tuple[list[str], np.ndarray]:
@@ -287,6 +337,7 @@ def check_benchmark(kit: Kit) -> list[Finding]:
             "",
         )
     )
+    out.append(_urdf_inverse_dynamics(kit, payload, names, (q, qd, qdd), recorded["max_torque"]))
     out.append(
         _at_most(
             "benchmark.forcerange",

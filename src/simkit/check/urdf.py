@@ -7,6 +7,7 @@ import logging
 import numpy as np
 
 from simkit.check.findings import Finding, compare, require
+from simkit.check.fk import fk_agrees
 from simkit.check.kit import Kit
 from simkit.check.mujoco import random_configs
 
@@ -42,32 +43,14 @@ def check_urdf(kit: Kit) -> list[Finding]:
     tool = kit.doc.get("tool_frame")
     if tool:
         names = [j["name"] for j in kit.joints]
-        errors, rot_errors = [], []
-        for q in random_configs(kit, 10, seed=1):
+
+        def tool_pose(q: np.ndarray) -> np.ndarray:
             urdf.update_cfg(dict(zip(names, q, strict=True)))
-            T = urdf.get_transform(tool, kit.base_frame)
-            ref = kit.fk(q)
-            errors.append(T[:3, 3] - ref[:3, 3])
-            rot_errors.append(T[:3, :3] - ref[:3, :3])
-        findings.append(
-            compare(
-                "fk.yourdfpy_vs_robot_json",
-                f"{tool} at 10 random configurations",
-                np.zeros((len(errors), 3)),
-                errors,
-                1e-6,
-                "m",
-            )
-        )
-        findings.append(
-            compare(
-                "fk.yourdfpy_vs_robot_json.rotation",
-                f"{tool} rotation at 10 random configurations (matrix entries)",
-                np.zeros((len(rot_errors), 3, 3)),
-                rot_errors,
-                1e-6,
-                "",
-            )
+            return urdf.get_transform(tool, kit.base_frame)
+
+        configs = random_configs(kit, 10, seed=1)
+        findings += fk_agrees(
+            kit, "fk.yourdfpy_vs_robot_json", "yourdfpy", tool_pose, configs, 1e-6
         )
     return findings
 

@@ -10,6 +10,10 @@ import numpy as np
 
 from simkit.model.robot import Inertial, Mesh
 
+#: Off-diagonal inertia below this fraction of the largest moment is round-off: the link axes
+#: are then the principal axes (keeps symmetric links free of arbitrary eigenvector choices).
+DIAGONAL_TOLERANCE = 1e-9
+
 
 def volume_integrals(mesh: Mesh) -> tuple[float, np.ndarray, np.ndarray]:
     """Volume (m^3), centroid (m) and inertia tensor about the centroid per unit density."""
@@ -73,3 +77,19 @@ def from_solid(mesh: Mesh, mass: float) -> Inertial:
             float(scaled[1, 2]),
         ),
     )
+
+
+def principal_axes(tensor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(diagonal inertia, R) with tensor = R diag R^T, R a proper rotation with a fixed sign
+    convention, so the same tensor always gives the same quaternion."""
+    diag = np.diag(tensor)
+    off = tensor - np.diag(diag)
+    if np.max(np.abs(off)) <= DIAGONAL_TOLERANCE * max(float(np.max(np.abs(diag))), 1e-300):
+        return diag.copy(), np.eye(3)
+    values, vectors = np.linalg.eigh(tensor)
+    for col in range(3):
+        if vectors[np.argmax(np.abs(vectors[:, col])), col] < 0:
+            vectors[:, col] = -vectors[:, col]
+    if np.linalg.det(vectors) < 0:
+        vectors[:, 2] = -vectors[:, 2]
+    return values, vectors

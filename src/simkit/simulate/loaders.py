@@ -15,11 +15,15 @@ def load_mjcf_file(path: Path):
 
 
 def load_urdf_file(urdf: Path):
-    """Compile the URDF at `urdf` in MuJoCo, keeping fixed frames as bodies and the relative
-    mesh paths (MuJoCo's URDF reader strips directories unless told not to)."""
+    """Compile the URDF at `urdf` in MuJoCo (`load_urdf_text`)."""
+    return load_urdf_text(urdf.read_text(encoding="utf-8"), urdf)
+
+
+def load_urdf_text(text: str, urdf: Path):
+    """Compile URDF `text` whose mesh paths are relative to the file `urdf`, keeping fixed
+    frames as bodies (MuJoCo's URDF reader strips directories unless told not to)."""
     import mujoco
 
-    text = urdf.read_text(encoding="utf-8")
     ext = '<mujoco><compiler strippath="false" fusestatic="false" discardvisual="true"/></mujoco>'
     text = re.sub(r"(<robot\b[^>]*>)", r"\1" + ext, text, count=1)
     # mesh paths made absolute, so the copy can live outside the kit (which may be read-only)
