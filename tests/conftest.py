@@ -52,3 +52,15 @@ def pytest_addoption(parser):
         action="store_true",
         help="rewrite tests/golden/ from the current emitters instead of comparing",
     )
+
+
+#: Fixtures that build (and check) real kits: a test using any of them is in the slow tier.
+KIT_FIXTURES = {"kit_factory", "rosie_1000", "rosie_1000_published"}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark kit-building tests `slow`, so `pytest -m "not slow"` is the fast unit tier. Tests
+    that build without these fixtures carry an explicit `@pytest.mark.slow`."""
+    for item in items:
+        if KIT_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)

@@ -197,6 +197,7 @@ def test_cli_list_and_version():
     assert names == sorted(names)
 
 
+@pytest.mark.slow
 def test_check_on_missing_folder_is_one_line(tmp_path):
     proc = subprocess.run(
         [sys.executable, "-m", "simkit.cli", "check", str(tmp_path / "nope")],
@@ -208,6 +209,7 @@ def test_check_on_missing_folder_is_one_line(tmp_path):
     assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_warm_rebuild_reuses_check_findings_of_identical_kit(tmp_path):
     from simkit.kitio.cache import Cache
 

@@ -90,6 +90,7 @@ def test_location_env_then_user_cache_dir(tmp_path, monkeypatch):
     assert default_dir() == type(default_dir())(user_cache_dir("simkit", appauthor=False))
 
 
+@pytest.mark.slow
 def test_cli_cache_dir_and_no_cache(tmp_path):
     """`--no-cache` writes no entry; `--cache-dir` fills the folder given (link solids and
     collision pieces of every link)."""
@@ -107,6 +108,7 @@ def test_cli_cache_dir_and_no_cache(tmp_path):
     assert len(list((on / "link_solid").rglob("*.npz"))) == 7
 
 
+@pytest.mark.slow
 def test_warm_derive_hits_every_step_and_emits_the_same_bytes(tmp_path):
     """Link solids, collision pieces and the cached robot-level steps come back from the
     cache, and the kit's files are byte-identical to the cold build's."""

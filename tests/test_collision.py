@@ -55,6 +55,7 @@ def test_distance_to_surface_matches_a_box():
         assert got == pytest.approx(exact[k : k + 40].max(), abs=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ROSIES)
 def test_rosie_links_have_at_most_ten_convex_pieces_covering_the_visual(name):
     robot = model_from_spec(name)
@@ -119,6 +120,7 @@ def _pieces(robot) -> dict[str, list[bytes]]:
     }
 
 
+@pytest.mark.slow
 def test_coacd_cached_warm_runs_none_and_corrupt_entries_are_repaired(tmp_path):
     cache = Cache.at(tmp_path / "cache")
     start = collision.COACD_RUNS

@@ -173,6 +173,7 @@ def _without_decision() -> str:
     return text
 
 
+@pytest.mark.slow
 def test_spec_without_the_decision_fails_in_one_line(tmp_path):
     path = tmp_path / "ecn_2r_nodecision.yaml"
     path.write_text(_without_decision())

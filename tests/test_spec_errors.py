@@ -185,6 +185,7 @@ def test_library_reports_file_line_field(tmp_path, label, old, new, needle, fiel
         "missing mesh file",
     ],
 )
+@pytest.mark.slow
 def test_cli_one_line_no_traceback_no_output(tmp_path, label):
     case = next(c for c in CASES if c[0] == label)
     path = _variant(tmp_path, case[1], case[2])
@@ -203,6 +204,7 @@ def test_cli_one_line_no_traceback_no_output(tmp_path, label):
     assert not any(out.glob("*_description")) and not any(out.glob("*.zip"))
 
 
+@pytest.mark.slow
 def test_cli_unknown_robot_and_missing_file(tmp_path):
     for target in ("no_such_robot", str(tmp_path / "missing.yaml")):
         proc = subprocess.run(

@@ -124,6 +124,7 @@ def test_missing_usd_fails(rosie_1000, tmp_path):
     assert [f.check for f in check_usd(Kit.open(kit)) if not f.ok] == ["usd.present"]
 
 
+@pytest.mark.slow
 def test_usdc_build(tmp_path):
     result = CliRunner().invoke(
         main,
@@ -137,6 +138,7 @@ def test_usdc_build(tmp_path):
     assert _failed(check_usd(Kit.open(kit))) == []
 
 
+@pytest.mark.slow
 def test_generic_robot(mix_kit):
     """Floating base (no joint to the world), prismatic and continuous joints, negative and
     oblique axes, capsule/box/sphere/cylinder colliders: all agree with the MJCF."""

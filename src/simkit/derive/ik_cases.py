@@ -202,7 +202,7 @@ def cases_document(robot: Robot, arm: ArmChain) -> dict:
             "branch_flags": BRANCH_FLAGS,
             "expected": "the solution reached by following the straight move from the seed "
             f"pose in {MOVE_STEPS} steps, each step the solution nearest the previous one",
-            "provenance": f"solved by simkit {__version__} (src/simkit/ik.py) on this kit's own "
+            "provenance": f"solved by simkit {__version__} (src/simkit/model/ik.py) on this kit's own "
             "chain, the joints of robot.json; not RosieOS's resolver",
             "seed": robot.seed,
         },
