@@ -10,6 +10,7 @@ from simkit.check.fk import fk_agrees
 from simkit.check.kit import Kit
 from simkit.check.mujoco import random_configs
 from simkit.check.readers.glb import read_glb
+from simkit.kitio.stl import from_stl
 from simkit.model.kinematics import axis_angle, quat_matrix, transform
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
@@ -32,7 +33,6 @@ def _outside(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.
 def check_collision(kit: Kit) -> list[Finding]:
     """Every link: at most ten pieces, each convex, together covering the visual mesh's
     vertices; robot.json's `geometry` piece counts match the files."""
-    from simkit.kitio.stl import from_stl
 
     most, worst_convex, worst_cover, mismatched = 0, 0.0, 0.0, []
     report = {

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simkit import __version__
 from simkit.model.ik import (
     BRANCH_FLAGS,
     METHOD,
@@ -150,7 +151,6 @@ def reference_cases(arm: ArmChain, seed: int) -> list[dict]:
 
 def cases_document(robot: Robot, arm: ArmChain) -> dict:
     """ik_cases.json: standalone (chain, units, frames, tolerance, solver, cases)."""
-    from simkit import __version__
 
     return {
         "robot": robot.name,
@@ -202,8 +202,8 @@ def cases_document(robot: Robot, arm: ArmChain) -> dict:
             "branch_flags": BRANCH_FLAGS,
             "expected": "the solution reached by following the straight move from the seed "
             f"pose in {MOVE_STEPS} steps, each step the solution nearest the previous one",
-            "provenance": f"solved by simkit {__version__} (src/simkit/model/ik.py) on this kit's own "
-            "chain, the joints of robot.json; not RosieOS's resolver",
+            "provenance": f"solved by simkit {__version__} (src/simkit/model/ik.py) on this "
+            "kit's own chain, the joints of robot.json; not RosieOS's resolver",
             "seed": robot.seed,
         },
         "cases": reference_cases(arm, robot.seed),
