@@ -8,29 +8,32 @@ from collections.abc import Callable
 
 
 class Reporter:
-    """`with Reporter("render", total, say) as bar: ... bar.step("home.png")`; `say` None is
-    quiet."""
+    """`with Reporter("render", say) as bar: bar.begin(total); ... bar.step("home.png")`;
+    `say` None is quiet."""
 
-    def __init__(self, label: str, total: int, say: Callable[[str], None] | None) -> None:
-        self.label, self.total, self.say, self.count = label, total, say, 0
+    def __init__(self, label: str, say: Callable[[str], None] | None) -> None:
+        self.label, self.say, self.total, self.count = label, say, 0, 0
         self.bar = None
-        if say is not None and total and sys.stderr.isatty():
+
+    def begin(self, total: int) -> None:
+        """Start the bar (on a terminal) once the number of items is known."""
+        self.total = total
+        if self.say is not None and total and sys.stderr.isatty():
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
             self.bar = Progress(
-                label,
+                self.label,
                 BarColumn(),
                 MofNCompleteColumn(),
                 TimeElapsedColumn(),
                 console=Console(stderr=True),
                 transient=True,
             )
-            self.task = self.bar.add_task(label, total=total)
+            self.task = self.bar.add_task(self.label, total=total)
+            self.bar.start()
 
     def __enter__(self) -> Reporter:
-        if self.bar is not None:
-            self.bar.start()
         return self
 
     def __exit__(self, *_exc) -> None:

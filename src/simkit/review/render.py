@@ -29,6 +29,7 @@ NO_GL_HINT = (
     "install Debian's libosmesa6 (apt-get install libosmesa6)"
 )
 DEFAULT_SIZE = (640, 480)
+DEFAULT_CAMERA = Camera()
 #: the backend that worked in this process, tried first next time
 _working: list[str] = []
 
@@ -84,10 +85,11 @@ def run_job(
     kits: Sequence[Path],
     items: Sequence[Item],
     size: tuple[int, int] = DEFAULT_SIZE,
-    camera: Camera = Camera(),
+    camera: Camera = DEFAULT_CAMERA,
     on_image: OnImage | None = None,
-) -> Camera:
-    """Render `items` in one process, with one camera fitted to all `kits`; returns it."""
+) -> dict:
+    """Render `items` in one process, with one camera fitted to all `kits`. Returns the
+    camera (`camera`, a Camera) and each kit's collision geometry hash (`collision`)."""
     from simkit.review.render_worker import NO_GL
 
     job = {
@@ -109,7 +111,7 @@ def run_job(
             raise SimkitError(f"render failed (MUJOCO_GL={backend}): {last}")
         if backend not in _working:
             _working.insert(0, backend)
-        return Camera.from_json(result["camera"])
+        return {"camera": Camera.from_json(result["camera"]), "collision": result["collision"]}
     raise SimkitError(NO_GL_HINT)
 
 
@@ -125,7 +127,7 @@ def render_kit(
     out_dir: Path,
     poses: Sequence[str] | None = None,
     size: tuple[int, int] = DEFAULT_SIZE,
-    camera: Camera = Camera(),
+    camera: Camera = DEFAULT_CAMERA,
     collision: bool = False,
     on_image: OnImage | None = None,
 ) -> list[Path]:

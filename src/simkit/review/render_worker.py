@@ -40,9 +40,14 @@ def _shared_camera(scenes: list, camera, size: tuple[int, int]):
     from simkit.review.scene import FLOOR, fit_camera, robot_points
 
     points = np.concatenate([robot_points(s, mujoco.MjData(s.model)) for s in scenes])
+    lo, hi = points.min(axis=0), points.max(axis=0)
     for scene in scenes:
         floor = mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_GEOM, FLOOR)
-        scene.model.geom_pos[floor] = (0.0, 0.0, min(0.0, float(points[:, 2].min())))
+        scene.model.geom_pos[floor] = (0.0, 0.0, min(0.0, float(lo[2])))
+        # MuJoCo scales clip planes, shadow maps and the floor's grid by the model's extent:
+        # one extent for all kits of the job, so an unchanged region renders the same pixels
+        scene.model.stat.center[:] = (lo + hi) / 2
+        scene.model.stat.extent = float(np.linalg.norm(hi - lo)) / 2
     fovy = float(scenes[0].model.vis.global_.fovy)
     return fit_camera(camera, points, fovy, size[0] / size[1])
 
@@ -92,7 +97,7 @@ def render_image(scene, renderer, camera, pose: str, collision: bool) -> np.ndar
 
 def run(job: dict) -> None:
     from simkit.review.png import write_png
-    from simkit.review.scene import Camera
+    from simkit.review.scene import Camera, collision_signature
 
     size = (int(job["size"][0]), int(job["size"][1]))
     with tempfile.TemporaryDirectory(prefix="simkit-render-") as tmp:
@@ -110,7 +115,8 @@ def run(job: dict) -> None:
         finally:
             for renderer in renderers:
                 renderer.close()
-    print(json.dumps({"camera": camera.to_json()}), flush=True)
+    signatures = [collision_signature(scene) for scene in scenes]
+    print(json.dumps({"camera": camera.to_json(), "collision": signatures}), flush=True)
 
 
 def main() -> None:

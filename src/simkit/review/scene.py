@@ -81,7 +81,9 @@ class Camera:
     @classmethod
     def from_json(cls, doc: dict) -> Camera:
         look = doc.get("lookat")
-        return cls(doc["azimuth"], doc["elevation"], doc.get("distance"), tuple(look) if look else None)
+        return cls(
+            doc["azimuth"], doc["elevation"], doc.get("distance"), tuple(look) if look else None
+        )
 
 
 def parse_camera(text: str) -> Camera:
@@ -254,6 +256,29 @@ def collision_colours(scene: KitScene, on: bool) -> None:
         model.geom_rgba[geom] = (*COLLISION_COLOURS[k % len(COLLISION_COLOURS)], COLLISION_ALPHA)
 
 
+def collision_signature(scene: KitScene) -> str:
+    """A hash of the collision geometry in its bodies' frames (shapes, sizes, placements,
+    mesh vertices and faces), to tell whether two kits' collision geometry differs."""
+    import hashlib
+
+    import mujoco
+
+    model = scene.model
+    digest = hashlib.sha256()
+    for geom in scene.collision:
+        body = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, model.geom_bodyid[geom])
+        digest.update(f"{body}:{int(model.geom_type[geom])}".encode())
+        for values in (model.geom_size[geom], model.geom_pos[geom], model.geom_quat[geom]):
+            digest.update(np.round(values, 9).tobytes())
+        mesh = model.geom_dataid[geom]
+        if int(model.geom_type[geom]) == int(mujoco.mjtGeom.mjGEOM_MESH) and mesh >= 0:
+            v0, nv = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+            f0, nf = model.mesh_faceadr[mesh], model.mesh_facenum[mesh]
+            digest.update(model.mesh_vert[v0 : v0 + nv].tobytes())
+            digest.update(model.mesh_face[f0 : f0 + nf].tobytes())
+    return digest.hexdigest()
+
+
 def _basis(azimuth: float, elevation: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """MuJoCo free camera axes (world frame): forward, right, up."""
     az, el = math.radians(azimuth), math.radians(elevation)
@@ -271,8 +296,10 @@ def fit_camera(camera: Camera, points: np.ndarray, fovy_deg: float, aspect: floa
         centre = np.asarray(camera.lookat, dtype=float)
     else:
         mid = (points.min(axis=0) + points.max(axis=0)) / 2
-        across = [(points - mid) @ axis for axis in (right, up)]
-        centre = mid + sum(axis * (a.min() + a.max()) / 2 for axis, a in zip((right, up), across))
+        centre = mid.copy()
+        for axis in (right, up):  # centre the extent across the view on the image centre
+            along = (points - mid) @ axis
+            centre += axis * (along.min() + along.max()) / 2
     v = points - centre
     tan_v = math.tan(math.radians(fovy_deg) / 2)
     tan_h = tan_v * aspect
