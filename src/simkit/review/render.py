@@ -81,26 +81,10 @@ def _attempt(backend: str, job: dict, on_image: OnImage | None) -> tuple[int, st
     return proc.wait(), err, result
 
 
-def run_job(
-    kits: Sequence[Path],
-    items: Sequence[Item],
-    size: tuple[int, int] = DEFAULT_SIZE,
-    camera: Camera = DEFAULT_CAMERA,
-    on_image: OnImage | None = None,
-) -> dict:
-    """Render `items` in one process, with one camera fitted to all `kits`. Returns the
-    camera (`camera`, a Camera) and each kit's collision geometry hash (`collision`)."""
+def _first_working(job: dict, on_image: OnImage | None = None) -> tuple[str, dict]:
+    """Run `job` with the first backend that makes an OpenGL context: (backend, result)."""
     from simkit.review.render_worker import NO_GL
 
-    job = {
-        "kits": [str(k) for k in kits],
-        "size": list(size),
-        "camera": camera.to_json(),
-        "items": [
-            {"kit": i.kit, "pose": i.pose, "collision": i.collision, "file": str(i.file)}
-            for i in items
-        ],
-    }
     for backend in _order():
         code, err, result = _attempt(backend, job, on_image)
         if code == NO_GL:
@@ -111,8 +95,38 @@ def run_job(
             raise SimkitError(f"render failed (MUJOCO_GL={backend}): {last}")
         if backend not in _working:
             _working.insert(0, backend)
-        return {"camera": Camera.from_json(result["camera"]), "collision": result["collision"]}
+        return backend, result
     raise SimkitError(NO_GL_HINT)
+
+
+def gl_backend() -> str | None:
+    """The MUJOCO_GL backend that renders on this machine (egl or osmesa), None if neither."""
+    try:
+        return _first_working({"probe": True})[0]
+    except SimkitError:
+        return None
+
+
+def run_job(
+    kits: Sequence[Path],
+    items: Sequence[Item],
+    size: tuple[int, int] = DEFAULT_SIZE,
+    camera: Camera = DEFAULT_CAMERA,
+    on_image: OnImage | None = None,
+) -> dict:
+    """Render `items` in one process, with one camera fitted to all `kits`. Returns the
+    camera (`camera`, a Camera) and each kit's collision geometry hash (`collision`)."""
+    job = {
+        "kits": [str(k) for k in kits],
+        "size": list(size),
+        "camera": camera.to_json(),
+        "items": [
+            {"kit": i.kit, "pose": i.pose, "collision": i.collision, "file": str(i.file)}
+            for i in items
+        ],
+    }
+    _backend, result = _first_working(job, on_image)
+    return {"camera": Camera.from_json(result["camera"]), "collision": result["collision"]}
 
 
 def kit_poses(kit: Path) -> dict[str, list[float]]:

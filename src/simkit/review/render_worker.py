@@ -119,9 +119,24 @@ def run(job: dict) -> None:
     print(json.dumps({"camera": camera.to_json(), "collision": signatures}), flush=True)
 
 
+def probe() -> None:
+    """Make one tiny render: exits NO_GL when this backend has no OpenGL context."""
+    import mujoco
+
+    from simkit.review.scene import KitScene
+
+    model = mujoco.MjModel.from_xml_string("<mujoco><worldbody/></mujoco>")
+    renderer = _renderer(KitScene("probe", model, {}, []), (16, 16))
+    renderer.update_scene(mujoco.MjData(model))
+    renderer.render()
+    renderer.close()
+    print(json.dumps({"camera": None, "collision": []}), flush=True)
+
+
 def main() -> None:
     try:
-        run(json.load(sys.stdin))
+        job = json.load(sys.stdin)
+        probe() if job.get("probe") else run(job)
     except SimkitError as exc:
         print(f"simkit: error: {exc}", file=sys.stderr)
         sys.exit(exc.exit_code)
