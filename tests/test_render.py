@@ -7,6 +7,7 @@ from __future__ import annotations
 import base64
 import itertools
 import json
+import os
 import re
 import shutil
 from pathlib import Path
@@ -32,6 +33,8 @@ SIZE = (320, 240)
 def gl() -> str:
     backend = gl_backend()
     if backend is None:
+        if os.environ.get("SIMKIT_REQUIRE_RENDER"):  # .ci/run installed libosmesa6
+            pytest.fail(NO_GL_HINT)
         pytest.skip(NO_GL_HINT)
     return backend
 
