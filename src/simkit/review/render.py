@@ -154,10 +154,11 @@ def render_kit(
         raise SimkitError(
             f"{kit}: no pose {missing[0]!r} in robot.json (poses: {', '.join(known)})"
         )
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".render-") as tmp:
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=out_dir.parent, prefix=".simkit-render-") as tmp:
         items = [Item(0, p, collision, Path(tmp) / f"{p}.png") for p in dict.fromkeys(wanted)]
         run_job([kit], items, size, camera, on_image)
+        out_dir.mkdir(exist_ok=True)
         paths = []
         for item in items:
             target = out_dir / item.file.name

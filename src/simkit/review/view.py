@@ -120,10 +120,12 @@ def serve_kit(
     """`simkit view`: serve until Ctrl-C, opening the page in the default browser."""
     with tempfile.TemporaryDirectory(prefix="simkit-view-") as tmp:
         if kit.is_file():
-            kit = _unzip(kit, Path(tmp))
-        elif not kit.is_dir():
+            folder = _unzip(kit, Path(tmp))
+        elif kit.is_dir():
+            folder = kit
+        else:
             raise SimkitError(f"{kit}: no such kit folder or zip")
-        server = start_server(kit, port)
+        server = start_server(folder, port)
         url = f"http://127.0.0.1:{server.server_address[1]}/"
         if say is not None:
             say(f"viewing {kit} at {url} (Ctrl-C stops)")
