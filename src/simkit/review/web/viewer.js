@@ -60,7 +60,7 @@ function frameCamera(view, object) {
   const box = new THREE.Box3().setFromObject(object);
   const centre = box.getCenter(new THREE.Vector3());
   const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.05);
-  const distance = radius / Math.sin(THREE.MathUtils.degToRad(view.camera.fov / 2));
+  const distance = (1.15 * radius) / Math.sin(THREE.MathUtils.degToRad(view.camera.fov / 2));
   // from +x, -y (kit frame) and above; the kit's (x, y, z) is three's (x, z, -y)
   const direction = new THREE.Vector3(1.2, 0.8, 1.6).normalize();
   view.camera.position.copy(centre).addScaledVector(direction, distance);
