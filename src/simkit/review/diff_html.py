@@ -133,7 +133,7 @@ def _changes_html(changes: Sequence[Change]) -> list[str]:
         rows = ["<tr><th>name</th><th>field</th><th>old</th><th>new</th><th>change</th></tr>"]
         for c in items:
             if c.change != "modified" or kind == "robot_json":
-                cells = [c.name, c.field or c.change, "", "", c.change]
+                cells = [c.name, c.field, "", "", "changed" if c.change == "modified" else c.change]
             else:
                 cells = [
                     c.name,
