@@ -134,7 +134,9 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
                 ),
             )
             page.goto(f"http://127.0.0.1:{server.server_address[1]}/")
-            page.wait_for_function("window.simkitViewer.ready || window.simkitViewer.error")
+            page.wait_for_function(
+                "window.simkitViewer.ready || window.simkitViewer.error", timeout=120_000
+            )
             assert page.evaluate("window.simkitViewer.error") is None
             sliders = page.locator("input[type=range][data-joint]")
             assert sliders.count() == len(doc["joints"])

@@ -34,7 +34,7 @@ COLLISION_COLOURS = (
     (0.95, 0.75, 0.1),
 )
 COLLISION_ALPHA, VISUAL_FAINT = 0.55, 0.25
-#: the distance leaves this much room around the robot's bounding box.
+#: the fitted distance leaves this much room around the robot (all named poses).
 MARGIN = 1.15
 POSE_NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
 
