@@ -137,16 +137,76 @@ def list_robots() -> None:
 @click.argument("old", type=click.Path(path_type=Path))
 @click.argument("new", type=click.Path(path_type=Path))
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON.")
-def diff(old: Path, new: Path, as_json: bool) -> None:
+@click.option(
+    "--html",
+    "html_out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also write a self-contained HTML report with renders of every named pose.",
+)
+def diff(old: Path, new: Path, as_json: bool, html_out: Path | None) -> None:
     """Report what changed between two kits (folders or zips); exit 0 equal, 1 different."""
     from simkit.diff import diff_kits, to_markdown
 
     try:
         report = diff_kits(old, new)
+        if html_out is not None:
+            from simkit.review.commands import diff_html
+
+            diff_html(report, old, new, html_out, _say)
     except SimkitError as exc:
         _fail(exc)
     click.echo(report.to_json() if as_json else to_markdown(report), nl=False)
     sys.exit(0 if report.equal else 1)
+
+
+def _say(msg: str) -> None:
+    err.print(msg, markup=False)
+
+
+@main.command()
+@click.argument("kit", type=click.Path(path_type=Path))
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), required=True)
+@click.option("--pose", "poses", multiple=True, help="A named pose (repeat). [default: all]")
+@click.option("--size", default="640x480", show_default=True, help="WIDTHxHEIGHT in pixels.")
+@click.option(
+    "--camera",
+    default=None,
+    help="AZIMUTH,ELEVATION[,DISTANCE[,X,Y,Z]] (deg, deg, m). [default: 135,-20, fitted]",
+)
+@click.option("--collision", is_flag=True, help="Show collision geometry, translucent.")
+@click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
+def render(
+    kit: Path,
+    out_dir: Path,
+    poses: tuple[str, ...],
+    size: str,
+    camera: str | None,
+    collision: bool,
+    quiet: bool,
+) -> None:
+    """Render KIT (folder or zip) to OUT/POSE.png with MuJoCo, one image per named pose."""
+    from simkit.review.commands import render_pngs
+
+    try:
+        paths = render_pngs(kit, out_dir, poses, size, camera, collision, None if quiet else _say)
+    except SimkitError as exc:
+        _fail(exc)
+    out.print(f"{len(paths)} image(s) in {out_dir}", markup=False)
+
+
+@main.command()
+@click.argument("kit", type=click.Path(path_type=Path))
+@click.option("--port", type=click.IntRange(0, 65535), default=8765, show_default=True)
+@click.option("--no-browser", is_flag=True, help="Only serve; print the address.")
+def view(kit: Path, port: int, no_browser: bool) -> None:
+    """Show KIT (folder) in the browser: three.js on 127.0.0.1, joint sliders, named poses."""
+    from simkit.review.view import serve_kit
+
+    try:
+        serve_kit(kit, port, open_browser=not no_browser, say=_say)
+    except SimkitError as exc:
+        _fail(exc)
 
 
 @main.command()

@@ -1,0 +1,252 @@
+// simkit view: a kit's GLB with joint sliders, named poses, frames and collision pieces.
+//
+// Kinematics follow the GLB emitter (emit/glb.py): each link node sits on its joint origin,
+// so a joint value q turns the child link node about the joint axis (node frame) by q, or
+// moves it along the axis by q for a prismatic joint. The scene's first node turns the kit's
+// Z-up frames into glTF's Y-up; positions reported by `simkitViewer.framePosition` are in the
+// kit's frame (m), below that node. Everything is fetched from this server: no network.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { STLLoader } from 'three/addons/loaders/STLLoader.js';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const COLLISION_PIECE = /^meshes\/collision\/(.+)_(\d+)\.stl$/;
+const PALETTE = [0xf25a1a, 0x1a8cf2, 0x33bf4d, 0xd933b3, 0xf2bf1a];
+const api = { ready: false, error: null, joints: [] };
+window.simkitViewer = api;
+
+function element(tag, attrs = {}, text = '') {
+  const node = document.createElement(tag);
+  for (const [key, value] of Object.entries(attrs)) node.setAttribute(key, value);
+  if (text) node.textContent = text;
+  return node;
+}
+
+async function fetchJson(url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
+  return response.json();
+}
+
+function setupScene(container) {
+  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(window.devicePixelRatio);
+  container.appendChild(renderer.domElement);
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(0xeef1f5);
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x8d8f94, 1.6));
+  const key = new THREE.DirectionalLight(0xffffff, 1.6);
+  key.position.set(2, 4, 2);
+  scene.add(key);
+  const fill = new THREE.DirectionalLight(0xffffff, 0.5);
+  fill.position.set(-2, 3, -2);
+  scene.add(fill);
+  const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 100);
+  const controls = new OrbitControls(camera, renderer.domElement);
+  const render = () => renderer.render(scene, camera);
+  controls.addEventListener('change', render);
+  const resize = () => {
+    const { clientWidth: w, clientHeight: h } = container;
+    renderer.setSize(w, h, false);
+    camera.aspect = w / Math.max(h, 1);
+    camera.updateProjectionMatrix();
+    render();
+  };
+  new ResizeObserver(resize).observe(container);
+  return { scene, camera, controls, render, resize };
+}
+
+function frameCamera(view, object) {
+  const box = new THREE.Box3().setFromObject(object);
+  const centre = box.getCenter(new THREE.Vector3());
+  const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.05);
+  const distance = (1.15 * radius) / Math.sin(THREE.MathUtils.degToRad(view.camera.fov / 2));
+  // from +x, -y (kit frame) and above; the kit's (x, y, z) is three's (x, z, -y)
+  const direction = new THREE.Vector3(1.2, 0.8, 1.6).normalize();
+  view.camera.position.copy(centre).addScaledVector(direction, distance);
+  view.camera.near = distance / 100;
+  view.camera.far = distance * 100;
+  view.camera.updateProjectionMatrix();
+  view.controls.target.copy(centre);
+  view.controls.update();
+  const grid = new THREE.GridHelper(radius * 4, 20, 0xa0a4aa, 0xc8cbd0);
+  grid.position.y = Math.min(box.min.y, 0);
+  view.scene.add(grid);
+}
+
+function makeJoint(spec, model) {
+  const node = model.getObjectByName(spec.child);
+  if (!node) throw new Error(`joint ${spec.name}: no node ${spec.child} in the GLB`);
+  return {
+    name: spec.name,
+    type: spec.type,
+    lower: spec.lower ?? -Math.PI,
+    upper: spec.upper ?? Math.PI,
+    axis: new THREE.Vector3(...spec.axis).normalize(),
+    node,
+    q0: node.quaternion.clone(),
+    p0: node.position.clone(),
+  };
+}
+
+function applyJoint(joint, q) {
+  if (joint.type === 'prismatic') {
+    const shift = joint.axis.clone().applyQuaternion(joint.q0).multiplyScalar(q);
+    joint.node.position.copy(joint.p0).add(shift);
+  } else {
+    const turn = new THREE.Quaternion().setFromAxisAngle(joint.axis, q);
+    joint.node.quaternion.copy(joint.q0).multiply(turn);
+  }
+}
+
+function jointLabel(joint, q) {
+  return joint.type === 'prismatic'
+    ? `${(q * 1000).toFixed(1)} mm`
+    : `${THREE.MathUtils.radToDeg(q).toFixed(1)}°`;
+}
+
+function buildSliders(joints, start, render) {
+  const box = document.getElementById('joints');
+  const sliders = {};
+  joints.forEach((joint, i) => {
+    const value = element('span', { class: 'value' });
+    const input = element('input', {
+      type: 'range', min: joint.lower, max: joint.upper, step: 'any', 'data-joint': joint.name,
+    });
+    const set = (q) => {
+      applyJoint(joint, q);
+      value.textContent = jointLabel(joint, q);
+      render();
+    };
+    input.addEventListener('input', () => set(Number(input.value)));
+    const label = element('label', {}, joint.name);
+    label.appendChild(value);
+    const row = element('div', { class: 'joint' });
+    row.append(label, input);
+    box.appendChild(row);
+    sliders[joint.name] = { input, set };
+    input.value = start[i] ?? 0;
+    set(Number(input.value));
+  });
+  return sliders;
+}
+
+function buildPoses(robot, joints, sliders) {
+  const box = document.getElementById('poses');
+  const poses = robot.poses ?? (robot.home ? { home: robot.home } : {});
+  for (const [name, values] of Object.entries(poses)) {
+    const button = element('button', { 'data-pose': name }, name);
+    button.addEventListener('click', () => joints.forEach((joint, i) => {
+      sliders[joint.name].input.value = values[i] ?? 0;
+      sliders[joint.name].set(Number(sliders[joint.name].input.value));
+    }));
+    box.appendChild(button);
+  }
+}
+
+function toggle(container, label, attrs, checked, onChange) {
+  const input = element('input', { type: 'checkbox', ...attrs });
+  input.checked = checked;
+  input.addEventListener('change', () => onChange(input.checked));
+  const row = element('label', { class: 'toggle' });
+  row.append(input, document.createTextNode(` ${label}`));
+  container.appendChild(row);
+  return input;
+}
+
+function buildFrames(robot, model, size, render) {
+  const box = document.getElementById('frames');
+  const names = [robot.base_frame, robot.tool_frame].filter((n) => n && model.getObjectByName(n));
+  for (const name of [...new Set(names)]) {
+    const axes = new THREE.AxesHelper(size);
+    axes.name = `${name}_axes`;
+    axes.material.depthTest = false;
+    axes.renderOrder = 2;
+    model.getObjectByName(name).add(axes);
+    toggle(box, name, { 'data-frame': name }, true, (on) => { axes.visible = on; render(); });
+  }
+  if (!names.length) box.textContent = 'none named in robot.json';
+}
+
+async function buildCollision(files, model, render) {
+  const box = document.getElementById('collision');
+  const byLink = new Map();
+  for (const path of files) {
+    const match = COLLISION_PIECE.exec(path);
+    if (match && model.getObjectByName(match[1])) {
+      if (!byLink.has(match[1])) byLink.set(match[1], []);
+      byLink.get(match[1]).push(path);
+    }
+  }
+  if (!byLink.size) {
+    box.textContent = 'no collision meshes in this kit';
+    return 0;
+  }
+  const loader = new STLLoader();
+  const groups = [];
+  let count = 0;
+  for (const [link, paths] of byLink) {
+    const group = new THREE.Group();
+    group.name = `${link}_collision`;
+    group.visible = false;
+    const geometries = await Promise.all(paths.map((p) => loader.loadAsync(`kit/${p}`)));
+    geometries.forEach((geometry) => {
+      const material = new THREE.MeshStandardMaterial({
+        color: PALETTE[count++ % PALETTE.length], transparent: true, opacity: 0.55,
+        depthWrite: false, polygonOffset: true, polygonOffsetFactor: -2, polygonOffsetUnits: -2,
+      });
+      group.add(new THREE.Mesh(geometry, material));
+    });
+    model.getObjectByName(link).add(group);
+    groups.push(group);
+  }
+  const links = [];
+  toggle(box, 'all collision pieces', { 'data-collision': '*' }, false, (on) => {
+    links.forEach((input) => { input.checked = on; input.dispatchEvent(new Event('change')); });
+  });
+  [...byLink.keys()].forEach((link, i) => {
+    links.push(toggle(box, `${link} (${byLink.get(link).length})`, { 'data-collision': link },
+      false, (on) => { groups[i].visible = on; render(); }));
+  });
+  return count;
+}
+
+async function main() {
+  const status = document.getElementById('status');
+  const robot = await fetchJson('kit/robot.json');
+  const files = await fetchJson('kit-files.json');
+  document.title = `simkit view: ${robot.name}`;
+  document.getElementById('title').textContent = robot.title ?? robot.name;
+  const view = setupScene(document.getElementById('view'));
+  const glb = robot.files?.glb ?? `glb/${robot.name}.glb`;
+  const gltf = await new GLTFLoader().loadAsync(`kit/${glb}`);
+  const model = gltf.scene;
+  view.scene.add(model);
+  const kitFrame = model.children[0];
+  const joints = robot.joints.filter((j) => j.type !== 'fixed').map((j) => makeJoint(j, model));
+  const start = robot.joints.filter((j) => j.type !== 'fixed').map((_, i) => (robot.home ?? [])[i]);
+  const sliders = buildSliders(joints, start, view.render);
+  buildPoses(robot, joints, sliders);
+  frameCamera(view, model);
+  const size = new THREE.Box3().setFromObject(model).getSize(new THREE.Vector3()).length();
+  buildFrames(robot, model, size / 10, view.render);
+  const pieces = await buildCollision(files, model, view.render);
+  api.joints = joints.map(({ name, type, lower, upper }) => ({ name, type, lower, upper }));
+  api.framePosition = (name) => {
+    const node = model.getObjectByName(name);
+    model.updateMatrixWorld(true);
+    const relative = kitFrame.matrixWorld.clone().invert().multiply(node.matrixWorld);
+    return new THREE.Vector3().setFromMatrixPosition(relative).toArray();
+  };
+  view.resize();
+  status.textContent = `${glb}: ${joints.length} joints, ${pieces} collision pieces`;
+  api.ready = true;
+}
+
+main().catch((error) => {
+  const status = document.getElementById('status');
+  status.textContent = `error: ${error.message ?? error}`;
+  status.className = 'error';
+  api.error = String(error.message ?? error);
+  console.error(error);
+});
