@@ -124,6 +124,30 @@ def write_tree(root: Path, files: dict[str, bytes]) -> None:
         target.write_bytes(data)
 
 
+def with_self_collision(kit: Path, files: dict[str, bytes], seed: int) -> dict[str, bytes]:
+    """`files` with robot.json `geometry.self_collision` computed by MuJoCo on the staged MJCF
+    (simulate.self_collision.summary; `seed` for the random configurations), rewritten there."""
+    import json
+    import math
+
+    import mujoco
+
+    from simkit.jsonout import dumps
+    from simkit.simulate.self_collision import summary
+
+    doc = json.loads(files["robot.json"])
+    model = mujoco.MjModel.from_xml_path(str(kit / doc["files"]["mjcf"]))
+    moving = [j for j in doc["joints"] if j["type"] in ("revolute", "continuous", "prismatic")]
+    lower = [-math.pi if j.get("lower") is None else j["lower"] for j in moving]
+    upper = [math.pi if j.get("upper") is None else j["upper"] for j in moving]
+    home = doc.get("home") or [0.0] * len(moving)
+    names = [j["name"] for j in moving]
+    doc["geometry"]["self_collision"] = summary(model, names, lower, upper, home, seed)
+    files = {**files, "robot.json": dumps(doc)}
+    (kit / "robot.json").write_bytes(files["robot.json"])
+    return files
+
+
 def _swap_in(staged: Path, final: Path) -> None:
     """Replace `final` with `staged`, keeping the old one until the new one is in place."""
     old = final.with_name(f".{final.name}.old")
@@ -158,6 +182,8 @@ def build(
     try:
         staged_kit = staging / kit_name
         write_tree(staged_kit, files)
+        say("simulate self-collision")
+        files = with_self_collision(staged_kit, files, robot.seed)
         staged_zip = staging / layout.zip_name(robot.name)
         staged_zip.write_bytes(zip_bytes(files, kit_name))
         findings: list[Finding] = []

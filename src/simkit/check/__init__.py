@@ -17,6 +17,7 @@ from simkit.check.motion_check import check_motion
 from simkit.check.mujoco_check import check_hold, check_models, check_parameters
 from simkit.check.published import check_published
 from simkit.check.ros_check import check_ros
+from simkit.check.self_collision_check import check_self_collision
 from simkit.check.urdf_check import check_urdf
 from simkit.check.usd_check import check_usd
 
@@ -35,6 +36,7 @@ CHECKS: dict[str, Check] = {
     "usd": check_usd,
     "motion": check_motion,
     "freefall": check_freefall,
+    "self_collision": check_self_collision,
 }
 
 
