@@ -224,13 +224,14 @@ def _derive_benchmark(robot: Robot, arm: ArmChain) -> Robot:
     # benchmark and derive import this module; the emitter package imports every emitter
     from simkit import benchmark
     from simkit.derive import with_json
-    from simkit.emit import mjcf
+    from simkit.emit import meshes, mjcf
 
     cycles = [
         benchmark.cycle(robot, arm, "cycle_1kg", WORK_PAYLOAD),
         benchmark.cycle(robot, arm, "cycle_rated", rated_payload(robot)),
     ]
     text = mjcf.emit(robot)[layout.mjcf(robot.name)].decode("utf-8")
+    assets = {path.removeprefix("meshes/"): data for path, data in meshes.emit(robot).items()}
     checks = {
         c.name: benchmark.kit_model_check(
             text,
@@ -240,6 +241,7 @@ def _derive_benchmark(robot: Robot, arm: ArmChain) -> Robot:
             c.q,
             c.qd,
             c.qdd,
+            assets,
         )
         for c in cycles
     }
