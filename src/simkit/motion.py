@@ -194,8 +194,10 @@ def derive_motion(robot: Robot) -> Robot:
 
 def _derive_ik_cases(robot: Robot, arm: ArmChain) -> Robot:
     from simkit.derive import with_json  # derive imports this module
+    from simkit.self_contact import depth_function
 
-    cases = ik_cases.cases_document(robot, arm)
+    depth = depth_function(robot, list(arm.names))
+    cases = ik_cases.cases_document(robot, arm, depth)
     seeds = {**robot.derived.get("seeds", {}), "ik_cases": robot.seed}
     robot = replace(robot, derived={**robot.derived, "ik_cases": cases, "seeds": seeds})
     reference = {
