@@ -256,12 +256,13 @@ def test_controllers_and_gazebo_launch(kit, doc):
     assert (
         types["joint_state_broadcaster"]["type"] == "joint_state_broadcaster/JointStateBroadcaster"
     )
-    for name in ("joint_1", "joint_2"):
-        assert types[f"{name}_position_controller"]["type"] == "pid_controller/PidController"
-        assert types[f"{name}_effort_controller"]["type"] == (
+    # the report's controller names (002_e760a3794accbbd5.txt section 5): joint1_..., joint2_...
+    for name, stem in (("joint_1", "joint1"), ("joint_2", "joint2")):
+        assert types[f"{stem}_position_controller"]["type"] == "pid_controller/PidController"
+        assert types[f"{stem}_effort_controller"]["type"] == (
             "effort_controllers/JointGroupEffortController"
         )
-        gains = config[f"{name}_position_controller"]["ros__parameters"]["gains"][name]
+        gains = config[f"{stem}_position_controller"]["ros__parameters"]["gains"][name]
         assert gains == {
             "p": 200.0,
             "i": 0.01,

@@ -17,6 +17,7 @@ steps 2-3 and section 5 step 1, in their ROS 2 / gz sim form:
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 
@@ -34,6 +35,13 @@ HARDWARE_INTERFACES = {
 }
 TRANSMISSION = "transmission_interface/SimpleTransmission"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"
+
+
+def controller_base(joint: str) -> str:
+    """Controller name stem of a joint: `joint_1` -> `joint1`, as the ECN 2R report names its
+    controllers and topics (002_e760a3794accbbd5.txt section 5: joint1_position_controller,
+    /joint1_position_controller/command); other names unchanged."""
+    return re.sub(r"_(\d+)$", r"\1", joint)
 
 
 def _placeholder(robot: Robot) -> str:
@@ -120,8 +128,12 @@ def controllers(robot: Robot) -> dict[str, list[str]]:
     rc = robot.ros2_control
     names = [j.name for j in joints(robot)]
     return {
-        "position": [f"{n}_position_controller" for n in names] if rc.position_pid else [],
-        "effort": [f"{n}_effort_controller" for n in names] if rc.effort_controllers else [],
+        "position": [f"{controller_base(n)}_position_controller" for n in names]
+        if rc.position_pid
+        else [],
+        "effort": [f"{controller_base(n)}_effort_controller" for n in names]
+        if rc.effort_controllers
+        else [],
     }
 
 
@@ -206,8 +218,8 @@ def _context(robot: Robot) -> dict:
         "joints": [
             {
                 "name": j.name,
-                "position": f"{j.name}_position_controller",
-                "effort": f"{j.name}_effort_controller",
+                "position": f"{controller_base(j.name)}_position_controller",
+                "effort": f"{controller_base(j.name)}_effort_controller",
             }
             for j in joints(robot)
         ],
