@@ -110,7 +110,7 @@ def test_ecn_2r_link_0_is_base_link_and_controllers_keep_the_report_names(kit_fa
         assert f"\n{name}:" in text
     for name in ("joint1_effort_controller", "joint2_effort_controller"):
         assert f"\n{name}:" in text
-    assert "link_0" not in (kit / "robot.json").read_text()
+    assert '"link_0"' not in (kit / "robot.json").read_text()
     readme = (kit / "README.md").read_text()
     assert "gazebo.launch.py control:=effort" in readme
     assert "`joint1_position_controller`" in readme

@@ -123,17 +123,18 @@ def test_a_tampered_mjcf_fails_naming_the_two_links(rosie_1000, tmp_path):
     kit = _copy(rosie_1000, tmp_path)
     path = kit / "mjcf" / "rosie_1000.xml"
     text = path.read_text()
-    # pull the wrist 200 mm back along the forearm: the flange sits inside link_4 at home
+    # pull the wrist 200 mm back along the forearm, out of its fork: the flange hits link_4
     text, n = re.subn(
         r'<body name="link_5" pos="0.38 0 0"', '<body name="link_5" pos="0.18 0 0"', text
     )
     assert n == 1
     path.write_text(text)
     bad = {f.check: f for f in check_self_collision(Kit.open(kit)) if not f.ok}
-    assert "self_collision.poses" in bad and "self_collision.sweep.J1" in bad
-    assert re.search(
-        r"link_4 and link_[56] penetrate \d+(\.\d)? mm", bad["self_collision.poses"].detail
-    )
+    assert "self_collision.poses" in bad and "self_collision.sweep.J5" in bad
+    assert "self_collision.sweep.J1" not in bad  # J1 alone moves nothing into anything
+    for check in ("self_collision.poses", "self_collision.sweep.J5"):
+        assert re.search(r"link_4 and link_6 penetrate \d+\.\d mm", bad[check].detail)
+    assert "pose 'work'" in bad["self_collision.poses"].detail
 
 
 @slow

@@ -138,12 +138,17 @@ def document(robot: Robot) -> tuple[dict, bytes]:
         {
             "name": f"{robot.name}_y_up",
             "rotation": list(Y_UP),
-            "children": [1],
             "extras": {"note": "turns the kit's Z-up frames into glTF's Y-up"},
         },
-        {"name": robot.root, "children": []},
     ]
-    index = {robot.root: 1}
+    # A floating base has no URDF link for the world (urdf.py): its base link hangs on the Y-up
+    # node directly, so the GLB's nodes are exactly the URDF's links (issue 12).
+    if robot.floating_joint is None:
+        nodes[0]["children"] = [1]
+        nodes.append({"name": robot.root, "children": []})
+    else:
+        nodes[0]["children"] = []
+    index = {robot.root: len(nodes) - 1}
 
     def attach(parent: str, node: dict) -> None:
         nodes.append(node)
