@@ -138,7 +138,7 @@ def free_range(
         count = max(1, math.ceil(abs(span) / step))
         last = home[index]
         for k in range(1, count + 1):
-            q[index] = home[index] + span * k / count
+            q[index] = limit if k == count else home[index] + span * k / count
             hit = worst(model, data, adr, q)
             if hit is not None and hit.depth > tol:
                 break
@@ -195,7 +195,7 @@ def summary(
                 "joint": name,
                 "lower": lo,
                 "upper": hi,
-                "limited_by_collision": lo > lower[i] or hi < upper[i],
+                "limited_by_collision": bool(lo > lower[i] or hi < upper[i]),
             }
         )
     fraction = contact_fraction(model, data, adr, lower, upper, seed, samples, tol)
