@@ -160,7 +160,7 @@ def test_an_unflagged_colliding_ik_solution_fails(rosie_1000, tmp_path):
 @slow
 def test_derived_depth_flags_listed_solutions(rosie_1000):
     from simkit.build import model_from_spec
-    from simkit.ik import ArmChain
+    from simkit.ik import Solution
     from simkit.ik_cases import _listed
     from simkit.self_contact import depth_function
 
@@ -171,14 +171,7 @@ def test_derived_depth_flags_listed_solutions(rosie_1000):
     folded = [0.0, 0.0, math.radians(100), 0.0, 0.0, 0.0]
     assert depth(folded) > 0.01
 
-    class Solution:  # the shape of ik.Solution that _listed reads
-        q = folded
-
-        def as_json(self):
-            return {"q": list(self.q)}
-
-    assert ArmChain  # the chain type the real cases use
-    listed = _listed(Solution(), depth)
+    listed = _listed(Solution(tuple(folded), "front", "down", "noflip"), depth)
     assert listed["self_collision"] is True
     assert listed["self_collision_depth_m"] == pytest.approx(depth(folded))
 
