@@ -160,12 +160,14 @@ print("MASSES", sorted(masses.items()))
     assert abs(sum(masses.values()) - 38.6) < 1e-9  # exactly the robot mass
 
 
+@pytest.mark.slow
 def test_ik_cases_snippet(rosie_1000):
     out = _run(rosie_1000.kit_dir, IK_CASES_SNIPPET)
     count, worst, tolerance = out[-1].split()[0], float(out[-1].split()[4]), out[-1].split()[-1]
     assert count == "12" and worst < float(tolerance)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("robot", ["rosie_600", "rosie_1000", "rosie_1400"])
 def test_readme_carries_the_page_snippets(kit_factory, robot):
     """The kit README's quickstart is the kit page's, apart from the file location (and the
