@@ -9,6 +9,9 @@ Layout follows the glTF 2.0 specification (Khronos, "GLB File Format Specificati
 header, a JSON chunk padded with spaces and a BIN chunk padded with zeros, both to 4 bytes.
 Positions are float32, indices uint16 or uint32; no normals, so viewers shade flat (spec
 section 3.7.2.1). Byte-identical across builds: no clock, fixed order, `jsonout` numbers.
+
+Node names are the URDF link names, exactly (issue 12). A loader may rename one on load: trimesh
+turns a node called "world" (the ECN 2R's root link) into "world_1", its own root being "world".
 """
 
 from __future__ import annotations
