@@ -255,7 +255,7 @@ def test_collision_capsules_and_excludes(asimov, model):
             assert all(model.geom_size[i, 0] == pytest.approx(0.01) for i in geoms)
             axes = [model.geom_quat[i] for i in geoms]  # parallel: one orientation
             assert all(np.allclose(q, axes[0]) for q in axes)
-        knee = model.geom(f"{side}_knee_link_collision_00")
+        knee = model.geom(f"{side}_knee_link_collision")  # the page's name
         assert knee.size[0] == pytest.approx(0.05) and knee.size[1] == pytest.approx(0.125)
     # visual geoms (group 2) never collide
     visual = [i for i in range(model.ngeom) if model.geom_group[i] == 2]
@@ -316,7 +316,8 @@ def test_urdf_robot_json_readme(asimov):
     assert len(doc["joints"]) == 14 and doc["base_frame"] == "pelvis_link"
     readme = (asimov.kit_dir / "README.md").read_text()
     assert "useFixedBase=False" in readme and "stretched" not in readme
-    code = "\n".join(re.findall(r"```python\n(.*?)```", readme, re.S)[:1])
+    blocks = re.findall(r"```python\n(.*?)```", readme, re.S)
+    code = next(b for b in blocks if "mj_resetDataKeyframe" in b)  # after the page's snippets
     out = subprocess.run(
         [sys.executable, "-c", code],
         cwd=asimov.kit_dir,

@@ -86,7 +86,7 @@ TAMPER = [
         "inertia.mjcf",
     ),
     ("mjcf", 'kp="15000"', 'kp="150000"', "mjcf.servo_gains"),
-    ("mjcf", 'kv="346.4866122"', 'kv="34.64866122"', "mjcf.servo_gains"),
+    ("mjcf", 'kv="340.0092371"', 'kv="34.00092371"', "mjcf.servo_gains"),
     ("mjcf", 'forcerange="-191.9 191.9"', 'forcerange="-150 150"', "mjcf.forcerange"),
     ("mjcf", 'ctrlrange="-2.792526803', 'ctrlrange="-1.792526803', "mjcf.ctrlrange"),
     ("mjcf", 'armature="0.357035"', 'armature="0.0357035"', "mjcf.joint_dynamics"),

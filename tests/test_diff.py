@@ -48,13 +48,13 @@ def test_kit_against_itself_and_its_zip_is_equal(rosie_1000):
 
 def test_one_limit_and_one_mass_change_report_exactly_those_two(rosie_1000, copy):
     def change(doc):
-        doc["joints"][1]["upper"] = 2.0  # joint_2, rad
+        doc["joints"][1]["upper"] = 2.0  # J2, rad
         doc["links"][2]["mass"] = 11.0  # link_2, kg
 
     _edit_json(copy, change)
     report = diff_kits(rosie_1000.kit_dir, copy)
     assert [_key(c) for c in report.changes] == [
-        ("joint", "joint_2", "modified", "upper"),
+        ("joint", "J2", "modified", "upper"),
         ("link", "link_2", "modified", "mass"),
     ]
     joint, link = report.changes
@@ -62,9 +62,7 @@ def test_one_limit_and_one_mass_change_report_exactly_those_two(rosie_1000, copy
     assert (link.old, link.new, link.unit) == (10.4, 11.0, "kg")
     assert report.changed == ["robot.json"] and not report.added and not report.removed
     text = to_markdown(report)
-    assert (
-        "| `joint_2` | upper | 2.35619 rad (135 deg) | 2 rad (114.59 deg) | -0.356194 rad" in text
-    )
+    assert "| `J2` | upper | 2.35619 rad (135 deg) | 2 rad (114.59 deg) | -0.356194 rad" in text
     assert "| `link_2` | mass | 10.4 kg | 11 kg | +0.6 kg, 5.77 % |" in text
     result = CliRunner().invoke(main, ["diff", "--json", str(rosie_1000.kit_dir), str(copy)])
     assert result.exit_code == 1
@@ -97,10 +95,10 @@ def test_each_kind_of_change(rosie_1000, copy):
     report = diff_kits(rosie_1000.kit_dir, copy)
     keys = {_key(c) for c in report.changes}
     assert keys >= {
-        ("joint", "joint_1", "modified", "max_velocity"),
-        ("joint", "joint_1", "modified", "effort_peak"),
-        ("joint", "joint_3", "modified", "lower"),
-        ("joint", "joint_3", "modified", "drive_peak_torque_at_joint"),
+        ("joint", "J1", "modified", "max_velocity"),
+        ("joint", "J1", "modified", "effort_peak"),
+        ("joint", "J3", "modified", "lower"),
+        ("joint", "J3", "modified", "drive_peak_torque_at_joint"),
         ("joint", "base_joint", "removed", ""),
         ("link", "link_1", "modified", "com"),
         ("link", "link_1", "modified", "inertia"),

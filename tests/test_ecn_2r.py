@@ -133,7 +133,8 @@ def test_joint_limits_friction_in_urdf_and_mjcf(urdf, mj):
 
 def test_world_mounting(doc, urdf, mj):
     """The fixed world joint (report section 4 step 1) puts the joint axes horizontal, so the
-    arm swings in a vertical plane; the MJCF has it as link_0's body pose."""
+    arm swings in a vertical plane; the MJCF has it as base_link's body pose (the report's
+    link 0)."""
     joint = urdf.find("joint[@name='world_joint']")
     assert joint.get("type") == "fixed" and joint.find("parent").get("link") == "world"
     assert joint.find("origin").get("xyz") == "0 0 1"
@@ -142,7 +143,7 @@ def test_world_mounting(doc, urdf, mj):
     )
     data = mujoco.MjData(mj)
     mujoco.mj_forward(mj, data)
-    body = data.body("link_0")
+    body = data.body("base_link")  # the report's link 0
     assert np.allclose(body.xpos, [0, 0, 1.0])
     assert np.allclose(body.xmat.reshape(3, 3), rpy_matrix((np.pi / 2, -np.pi / 2, 0)), atol=1e-9)
     axis = data.xaxis[mj.joint("joint_1").id]
@@ -155,7 +156,7 @@ def test_world_mounting(doc, urdf, mj):
 def test_link_0_inertia_decision_is_recorded(doc, urdf):
     entry = doc["links"][0]
     decision = entry["inertia_decision"]
-    assert entry["name"] == "link_0" and decision["action"] == "exclude_from_dynamics"
+    assert entry["name"] == "base_link" and decision["action"] == "exclude_from_dynamics"
     reported = tuple(decision["reported"][k] for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"))
     assert reported == LINK_0_REPORTED
     assert "triangle inequality" in decision["problem"] and decision["reason"]
@@ -163,7 +164,7 @@ def test_link_0_inertia_decision_is_recorded(doc, urdf):
     assert [decision["emitted"][k] for k in ("ixx", "iyy", "izz")] == pytest.approx([mean] * 3)
     assert entry["inertia"]["izz"] == pytest.approx(mean)  # what the files carry
     assert entry["mass"] == 15.136597
-    attrs = urdf.find("link[@name='link_0']/inertial/inertia").attrib
+    attrs = urdf.find("link[@name='base_link']/inertial/inertia").attrib
     assert float(attrs["izz"]) == pytest.approx(mean)
 
 
@@ -257,12 +258,13 @@ def test_controllers_and_gazebo_launch(kit, doc):
     assert (
         types["joint_state_broadcaster"]["type"] == "joint_state_broadcaster/JointStateBroadcaster"
     )
-    for name in ("joint_1", "joint_2"):
-        assert types[f"{name}_position_controller"]["type"] == "pid_controller/PidController"
-        assert types[f"{name}_effort_controller"]["type"] == (
+    # the report's controller names (002_e760a3794accbbd5.txt section 5): joint1_..., joint2_...
+    for name, stem in (("joint_1", "joint1"), ("joint_2", "joint2")):
+        assert types[f"{stem}_position_controller"]["type"] == "pid_controller/PidController"
+        assert types[f"{stem}_effort_controller"]["type"] == (
             "effort_controllers/JointGroupEffortController"
         )
-        gains = config[f"{name}_position_controller"]["ros__parameters"]["gains"][name]
+        gains = config[f"{stem}_position_controller"]["ros__parameters"]["gains"][name]
         assert gains == {
             "p": 200.0,
             "i": 0.01,

@@ -116,7 +116,9 @@ def test_every_solution_is_within_limits_and_reaches_the_target(kit_factory, nam
         move = np.asarray(case["move"]["q"])
         assert np.allclose(move[0], case["seed"]["q"]) and np.allclose(move[-1], sols[0]["q"])
         assert np.abs(np.diff(move, axis=0)).max() < ik_cases.MAX_STEP
-    assert total > 12 * 8  # +-2 pi multiples of J1, J4, J6 add solutions to the 8 branches
+    # +-2 pi multiples of J1, J4, J6 add solutions to the 8 branches; the elbow limits at the
+    # collision-free range (issue 12: J3 up to +60..+70 deg) remove some of the elbow branches
+    assert total > 12 * 6
 
 
 def test_cases_spread_over_the_workspace(cases):

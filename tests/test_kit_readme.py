@@ -11,7 +11,7 @@ import pytest
 BLOCK = re.compile(r"```python\n(.*?)```", re.S)
 
 
-@pytest.mark.parametrize("name", ["rosie_1000", "asimov", "ecn_2r"])
+@pytest.mark.parametrize("name", ["rosie_600", "rosie_1000", "rosie_1400", "asimov", "ecn_2r"])
 def test_readme_python_snippets_run_inside_the_kit(kit_factory, name):
     kit = kit_factory(name).kit_dir
     blocks = BLOCK.findall((kit / "README.md").read_text())

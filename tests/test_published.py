@@ -30,7 +30,7 @@ PUBLISHED = {
         wrist=1.4337, reach=(1.400, 1.499), tool0=(0.834, 0, 0.756), height=0.0294, mass=77.0
     ),
 }
-JOINTS = [f"joint_{i}" for i in range(1, 7)]
+JOINTS = [f"J{i}" for i in range(1, 7)]  # kit page: J1 to J6
 REPO = Path(__file__).resolve().parents[1]
 MM = 1e-4  # 0.1 mm
 KG = 0.01
@@ -200,5 +200,5 @@ def test_unpublished_values_are_marked_estimated(kit):
         assert {"effort_continuous", "drive"} <= estimated, name
         # J3 (upper arm) and J6 (flange) follow from the published figures; the splits of the
         # J1/J2 heights and of the forearm between J4 and J5 do not
-        assert ("xyz" in estimated) == (name in ("joint_1", "joint_2", "joint_4", "joint_5"))
+        assert ("xyz" in estimated) == (name in ("J1", "J2", "J4", "J5"))
     assert {"payload", "repeatability_mm"} <= set(doc["provenance"]["published_estimated"])

@@ -9,6 +9,7 @@ import sys
 import textwrap
 
 import numpy as np
+import pytest
 
 MUJOCO_SNIPPET = """
 import mujoco
@@ -63,6 +64,39 @@ def fk(q):
 print(fk(robot["poses"]["stretched"])[:3, 3]) # (m)
 print(fk(robot["home"])[:3, 3])
 """
+
+
+IK_CASES_SNIPPET = """
+import json
+import numpy as np
+doc = json.load(open("ik_cases.json"))
+def rot(axis, q):
+    x, y, z = axis
+    c, s, t = np.cos(q), np.sin(q), 1 - np.cos(q)
+    return np.array([[t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+[t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+[t * x * z - s * y, t * y * z + s * x, t * z * z + c]])
+def fk(q):
+    T = np.eye(4)
+    for j, qi in zip(doc["chain"]["joints"], q):
+        A = np.eye(4)
+        A[:3, 3], A[:3, :3] = j["origin_xyz"], rot(j["axis"], qi)
+        T = T @ A
+    return T @ np.diag([1, -1, -1, 1]) # tool0: link_6 turned 180 deg about x
+worst = 0.0
+for case in doc["cases"]:
+    for sol in [case["expected"]] + case["all_solutions"]:
+        T = fk(sol["q"])
+        worst = max(worst, np.abs(T[:3, 3] - case["target"]["xyz"]).max(),
+np.abs(T[:3, :3] - case["target"]["rotation"]).max())
+print(len(doc["cases"]), "cases, worst error", worst, "tolerance", doc["tolerance"]["position_m"])
+"""
+
+
+def _words(code: str) -> list[str]:
+    """Code lines with whitespace collapsed, blank lines dropped: the page's text lost its
+    indentation of continuation lines and comment spacing, the README has PEP 8's."""
+    return [" ".join(line.split()) for line in code.splitlines() if line.strip()]
 
 
 def _run(kit_dir, code: str) -> list[str]:
@@ -124,3 +158,33 @@ print("MASSES", sorted(masses.items()))
     masses = dict(ast.literal_eval(line[line.index("[") :]))
     assert masses["tool0"] == 0.0
     assert abs(sum(masses.values()) - 38.6) < 1e-9  # exactly the robot mass
+
+
+@pytest.mark.slow
+def test_ik_cases_snippet(rosie_1000):
+    out = _run(rosie_1000.kit_dir, IK_CASES_SNIPPET)
+    count, worst, tolerance = out[-1].split()[0], float(out[-1].split()[4]), out[-1].split()[-1]
+    assert count == "12" and worst < float(tolerance)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("robot", ["rosie_600", "rosie_1000", "rosie_1400"])
+def test_readme_carries_the_page_snippets(kit_factory, robot):
+    """The kit README's quickstart is the kit page's, apart from the file location (and the
+    model number, as the page says: "change 1000 to 600 or 1400")."""
+    readme = _words((kit_factory(robot).kit_dir / "README.md").read_text())
+    model = robot.split("_")[1]
+    fk_local = [line for line in _words(FK_SNIPPET) if 'robot["home"]' not in line]
+    for snippet in (MUJOCO_SNIPPET, PYBULLET_SNIPPET, IK_CASES_SNIPPET, "\n".join(fk_local)):
+        lines = [line.replace("rosie_1000", f"rosie_{model}") for line in _words(snippet)]
+        found = any(readme[i : i + len(lines)] == lines for i in range(len(readme)))
+        assert found, f"README lacks the page snippet starting {lines[0]!r}"
+    text = " ".join(readme)
+    for pointer in (
+        "examples/fk_ik.py",
+        "ik_cases.json",
+        "benchmark/",
+        f"glb/rosie_{model}.glb",
+        "usd/",
+    ):
+        assert pointer in text

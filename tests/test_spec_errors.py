@@ -84,8 +84,8 @@ CASES = [
     ),
     (
         "malformed YAML",
-        "  - name: joint_3\n",
-        "  - name: joint_3\n   bad: [1, 2\n",
+        "  - name: J3\n",
+        "  - name: J3\n   bad: [1, 2\n",
         "bad: [1, 2",
         "<yaml>",
         "malformed YAML",

@@ -46,7 +46,7 @@ def test_groups_states_virtual_joint_end_effector(rosie_1000):
         assert list(values) == names
         assert np.allclose(list(values.values()), doc["poses"][name], atol=1e-9)
     assert math.degrees(
-        float(states["work"].find("joint[@name='joint_2']").get("value"))
+        float(states["work"].find("joint[@name='J2']").get("value"))
     ) == pytest.approx(30)
     vj = root.find("virtual_joint")
     assert (vj.get("type"), vj.get("parent_frame"), vj.get("child_link")) == (
@@ -154,8 +154,8 @@ def test_spec_declared_planning_groups(tmp_path):
         (s.get("group"), s.get("name")): [j.get("name") for j in s.iter("joint")]
         for s in root.iter("group_state")
     }
-    assert states[("arm", "home")] == ["joint_1", "joint_2", "joint_3"]
-    assert states[("wrist", "stretched")] == ["joint_4", "joint_5", "joint_6"]
+    assert states[("arm", "home")] == ["J1", "J2", "J3"]
+    assert states[("wrist", "stretched")] == ["J4", "J5", "J6"]
     assert root.find("end_effector").get("parent_group") == "wrist"
 
 

@@ -72,7 +72,7 @@ def test_stage_layout(rosie_1000):
     assert top.HasAPI(UsdPhysics.ArticulationRootAPI)
     base = UsdPhysics.FixedJoint(stage.GetPrimAtPath("/rosie_1000/joints/base_joint"))
     assert [str(t) for t in base.GetBody0Rel().GetTargets()] == ["/rosie_1000"]
-    j1 = UsdPhysics.RevoluteJoint(stage.GetPrimAtPath("/rosie_1000/joints/joint_1"))
+    j1 = UsdPhysics.RevoluteJoint(stage.GetPrimAtPath("/rosie_1000/joints/J1"))
     assert j1.GetAxisAttr().Get() == "Z"
     assert j1.GetLowerLimitAttr().Get() == -270 and j1.GetUpperLimitAttr().Get() == 270
     drive = UsdPhysics.DriveAPI.Get(j1.GetPrim(), "angular")
@@ -192,7 +192,7 @@ def test_readme_usd_snippet(rosie_1000):
         timeout=120,
     )
     assert proc.returncode == 0, proc.stderr
-    assert "joint_6 PhysicsRevoluteJoint" in proc.stdout
+    assert "J6 PhysicsRevoluteJoint" in proc.stdout
 
 
 ROBOTS = sorted(p.stem for p in (SPECS.parents[1] / "robots").glob("*.yaml"))

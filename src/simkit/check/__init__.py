@@ -18,6 +18,7 @@ from simkit.check.motion import check_motion
 from simkit.check.mujoco import check_hold, check_models, check_parameters
 from simkit.check.published_numbers import check_published
 from simkit.check.ros import check_ros
+from simkit.check.self_collision import check_self_collision
 from simkit.check.urdf import check_urdf
 from simkit.check.usd import check_usd
 from simkit.kitio.cache import Cache, cached_stage, decode_json, encode_json
@@ -37,6 +38,7 @@ CHECKS: dict[str, Check] = {
     "usd": check_usd,
     "motion": check_motion,
     "freefall": check_freefall,
+    "self_collision": check_self_collision,
 }
 
 

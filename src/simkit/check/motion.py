@@ -325,7 +325,9 @@ def check_benchmark(kit: Kit) -> list[Finding]:
     )
     text = kit.path(kit.mjcf).read_text(encoding="utf-8")
     payload = _payload(kit, bench["payload"]["cycle_1kg"])
-    result = kit_model_check(text, names, payload["link"], payload, q, qd, qdd)
+    meshes = kit.path("meshes")
+    assets = {f.relative_to(meshes).as_posix(): f.read_bytes() for f in meshes.rglob("*.stl")}
+    result = kit_model_check(text, names, payload["link"], payload, q, qd, qdd, assets)
     recorded = bench["kit_model_check"]
     out.append(
         compare(

@@ -62,7 +62,8 @@ def collision_findings(parsed: dict, mj, links: dict[str, str]) -> list[Finding]
 
 def _primitive_findings(parsed: dict, mj) -> list[Finding]:
     """Collision primitives (size, axis, pose in the link) vs the MJCF geom of the same name
-    (`LINK_collision_NN` there, `LINK/collisions/collision_NN` here)."""
+    (`LINK_collision_NN` there, or `LINK_collision` for a link's only primitive;
+    `LINK/collisions/collision_NN` here)."""
     exp, act, missing = [], [], []
     for kind, (paths, descs) in parsed.items():
         if str(kind).rsplit(".", 1)[-1] not in (
@@ -75,6 +76,8 @@ def _primitive_findings(parsed: dict, mj) -> list[Finding]:
         for path, d in zip(paths, descs, strict=True):
             name = f"{str(d.rigidBody).rsplit('/', 1)[-1]}_{str(path).rsplit('/', 1)[-1]}"
             geom = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_GEOM, name)
+            if geom < 0 and name.endswith("_collision_00"):  # a link's only primitive
+                geom = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_GEOM, name[:-3])
             if geom < 0:
                 missing.append(name)
                 continue
@@ -88,8 +91,12 @@ def _primitive_findings(parsed: dict, mj) -> list[Finding]:
             rot = np.zeros(9)
             mujoco.mju_quat2Mat(rot, mj.geom_quat[geom])
             pose[:3, :3], pose[:3, 3] = rot.reshape(3, 3), mj.geom_pos[geom]
+            theirs = matrix(d.localPos, d.localRot)
+            if hasattr(d, "halfHeight"):  # round about its axis: MJCF fromto picks its own x, y
+                pose[:3, :2] = theirs[:3, :2] = 0.0  # and its axis either way round
+                pose[:3, 2] *= 1.0 if pose[:3, 2] @ theirs[:3, 2] >= 0 else -1.0
             exp.append(np.concatenate([mj.geom_size[geom], pose[:3].ravel()]))
-            act.append(np.concatenate([size, matrix(d.localPos, d.localRot)[:3].ravel()]))
+            act.append(np.concatenate([size, theirs[:3].ravel()]))
     out = (
         [
             require(

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from simkit.derive import benchmark, ik_cases, motion
+from simkit.derive.self_contact import depth_function
 from simkit.kitio import layout
 from simkit.model import ik
 from simkit.model.ik import ArmChain
@@ -35,7 +36,10 @@ def derive_motion(robot: Robot) -> Robot:
 
 
 def _ik_cases(robot: Robot, arm: ArmChain) -> Robot:
-    cases = ik_cases.cases_document(robot, arm)
+    # seeds and expected solutions free of self-contact (issue 12), on the model's own
+    # collision geometry in memory
+    depth = depth_function(robot, list(arm.names))
+    cases = ik_cases.cases_document(robot, arm, depth)
     reference = {
         "file": layout.IK_CASES,
         "cases": len(cases["cases"]),

@@ -8,6 +8,8 @@ solution inside the joint limits (`all_solutions`). Seeded by the spec's `seed`.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 
 from simkit import __version__
@@ -22,6 +24,8 @@ from simkit.model.ik import (
 )
 from simkit.model.kinematics import axis_angle
 from simkit.model.robot import Robot
+
+Depth = Callable[[Sequence[float]], float]
 
 N_CASES = 12
 MOVE_STEPS = 40  # straight-line steps from the seed pose to the target
@@ -90,14 +94,33 @@ def resolve_move(arm: ArmChain, q_seed, T_target: np.ndarray) -> np.ndarray | No
     return np.array(path)
 
 
-def _case(arm: ArmChain, rng: np.random.Generator, sector: tuple[float, float]) -> dict | None:
+def _free(depth: Depth | None, q) -> bool:
+    """No self-contact at q (issue 12: seeds and expected solutions are collision-free)."""
+    return depth is None or depth(list(q)) <= 0.0
+
+
+def _listed(solution, depth: Depth | None) -> dict:
+    """A listed solution as JSON, flagged `self_collision` with its depth (m) if links meet."""
+    out = solution.as_json()
+    found = 0.0 if depth is None else depth(list(solution.q))
+    if found > 0.0:
+        out.update(self_collision=True, self_collision_depth_m=found)
+    return out
+
+
+def _case(
+    arm: ArmChain,
+    rng: np.random.Generator,
+    sector: tuple[float, float],
+    depth: Depth | None = None,
+) -> dict | None:
     """One candidate case with J1 inside `sector`, or None if it fails a condition."""
     lo, hi = np.maximum(arm.lower, -np.pi), np.minimum(arm.upper, np.pi)
     q_seed = rng.uniform(lo, hi)
     q_seed[0] = rng.uniform(*sector)
     direction = rng.normal(size=3)
     turn = rng.normal(size=3)
-    if not _conditioned(arm, q_seed):
+    if not _conditioned(arm, q_seed) or not _free(depth, q_seed):
         return None
     T0 = arm.fk(q_seed)
     target = np.eye(4)
@@ -109,6 +132,8 @@ def _case(arm: ArmChain, rng: np.random.Generator, sector: tuple[float, float]) 
     solutions = solve(arm, target)
     expected = nearest(solutions, path[-1])
     if expected is None or np.abs(np.subtract(expected.q, path[-1])).max() > 1e-9:
+        return None
+    if not _free(depth, expected.q):
         return None
     others = [s for s in solutions if s is not expected]
     return {
@@ -127,20 +152,21 @@ def _case(arm: ArmChain, rng: np.random.Generator, sector: tuple[float, float]) 
         },
         "target": {"xyz": list(target[:3, 3]), "rotation": target[:3, :3].tolist()},
         "expected": expected.as_json(),
-        "all_solutions": [s.as_json() for s in others],
+        "all_solutions": [_listed(s, depth) for s in others],
     }
 
 
-def reference_cases(arm: ArmChain, seed: int) -> list[dict]:
+def reference_cases(arm: ArmChain, seed: int, depth: Depth | None = None) -> list[dict]:
     """N_CASES cases spread over the workspace: J1 of case i in the i-th of N_CASES equal
-    sectors of its range (within +-pi), the rest seeded-random within the limits."""
+    sectors of its range (within +-pi), the rest seeded-random within the limits; with
+    `depth` (self_contact.depth_function), seeds and expected solutions free of self-contact."""
     rng = np.random.default_rng(seed)
     lo, hi = max(arm.lower[0], -np.pi), min(arm.upper[0], np.pi)
     edges = np.linspace(lo, hi, N_CASES + 1)
     cases = []
     for i in range(N_CASES):
         for _attempt in range(2000):
-            case = _case(arm, rng, (edges[i], edges[i + 1]))
+            case = _case(arm, rng, (edges[i], edges[i + 1]), depth)
             if case is not None:
                 cases.append({"name": f"case_{i + 1:02d}", **case})
                 break
@@ -149,7 +175,7 @@ def reference_cases(arm: ArmChain, seed: int) -> list[dict]:
     return cases
 
 
-def cases_document(robot: Robot, arm: ArmChain) -> dict:
+def cases_document(robot: Robot, arm: ArmChain, depth: Depth | None = None) -> dict:
     """ik_cases.json: standalone (chain, units, frames, tolerance, solver, cases)."""
 
     return {
@@ -206,5 +232,8 @@ def cases_document(robot: Robot, arm: ArmChain) -> dict:
             "kit's own chain, the joints of robot.json; not RosieOS's resolver",
             "seed": robot.seed,
         },
-        "cases": reference_cases(arm, robot.seed),
+        "self_collision": "seeds and expected solutions are free of self-contact (MuJoCo, "
+        "the kit's collision geometry, adjacent links excluded); a listed solution where links "
+        "meet has self_collision: true and self_collision_depth_m (m)",
+        "cases": reference_cases(arm, robot.seed, depth),
     }

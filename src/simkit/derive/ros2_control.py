@@ -5,10 +5,18 @@ needs, and robot.json's `ros2_control` entry. `emit/ros2_control.py` formats the
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 from simkit.kitio import layout
 from simkit.model.robot import Joint, Robot
+
+
+def controller_base(joint: str) -> str:
+    """Controller name stem of a joint: `joint_1` -> `joint1`, as the ECN 2R report names its
+    controllers and topics (002_e760a3794accbbd5.txt section 5: joint1_position_controller,
+    /joint1_position_controller/command); other names unchanged."""
+    return re.sub(r"_(\d+)$", r"\1", joint)
 
 
 def joints(robot: Robot) -> list[Joint]:
@@ -21,8 +29,12 @@ def controllers(robot: Robot) -> dict[str, list[str]]:
     rc = robot.ros2_control
     names = [j.name for j in joints(robot)]
     return {
-        "position": [f"{n}_position_controller" for n in names] if rc.position_pid else [],
-        "effort": [f"{n}_effort_controller" for n in names] if rc.effort_controllers else [],
+        "position": [f"{controller_base(n)}_position_controller" for n in names]
+        if rc.position_pid
+        else [],
+        "effort": [f"{controller_base(n)}_effort_controller" for n in names]
+        if rc.effort_controllers
+        else [],
     }
 
 

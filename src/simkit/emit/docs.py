@@ -75,6 +75,7 @@ def context(robot: Robot) -> dict:
         "sources": list(robot.sources),
         **_floating(robot),
         **_fk_snippet(robot),
+        **_page_extras(robot),
     }
 
 
@@ -104,6 +105,63 @@ def _fk_snippet(robot: Robot) -> dict:
         "fk_pose": pose or "home",
         "fk_base": movable[0].parent,
     }
+
+
+#: The Rosie kit page's quickstart target, J1..J6 in deg (000_5f76ade803e16979.txt, Quickstart).
+PAGE_TARGET_DEG = ("30", "45", "-10", "0", "-35", "0")
+
+
+def _page_extras(robot: Robot) -> dict:
+    """The kit page's own snippets for an arm with its conventions (`fk` "page"): its target,
+    the IK-cases check, and the paths of the benchmark files."""
+    page = _fk_snippet(robot)["fk"] == "page" and len(robot.movable_joints) == 6
+    movable = robot.movable_joints
+    return {
+        "page_target": list(PAGE_TARGET_DEG) if page else [],
+        "joint_span": f"{movable[0].name}..{movable[-1].name}" if movable else "",
+        "last_link": movable[-1].child if movable else "",
+        "ik_cases": layout.IK_CASES if page else "",
+        "benchmark": "benchmark/" if page else "",
+        "self_collision": True,
+        "mujoco_page": _mujoco_page(robot),
+        "gazebo": _gazebo(robot),
+    }
+
+
+def _gazebo(robot: Robot) -> dict | None:
+    """Controllers of launch/gazebo.launch.py per `control:=` mode, when the kit has it."""
+    if robot.ros2_control is None:
+        return None
+    from simkit.emit.ros2_control import controllers
+
+    names = controllers(robot)
+    return {
+        "default": robot.ros2_control.default_control,
+        "position": [f"`{n}`" for n in names["position"]],
+        "effort": [f"`{n}`" for n in names["effort"]],
+    }
+
+
+#: The names the Asimov MuJoCo reference's snippets use (001_71a395c46b8a5939.txt, "Loading
+#: and Using the Model"): a robot that has them all gets those snippets in its README.
+MUJOCO_PAGE_NAMES = {
+    "joint": "left_knee_joint",
+    "sensors": ("imu_ang_vel", "imu_lin_vel", "imu_quat"),
+}
+MUJOCO_PAGE = {
+    "source": "001_71a395c46b8a5939.txt",
+    "page_path": "sim-model/xmls/asimov.xml",
+    "knee_geom": "left_knee_link_collision",
+}
+
+
+def _mujoco_page(robot: Robot) -> dict | None:
+    """The Asimov reference's snippets apply when the robot has every name they use."""
+    joints = {j.name for j in robot.joints}
+    sensors = {s.name for s in (robot.mjcf.sensors if robot.mjcf else ())}
+    if MUJOCO_PAGE_NAMES["joint"] in joints and set(MUJOCO_PAGE_NAMES["sensors"]) <= sensors:
+        return MUJOCO_PAGE
+    return None
 
 
 def _floating(robot: Robot) -> dict:

@@ -9,6 +9,9 @@ Layout follows the glTF 2.0 specification (Khronos, "GLB File Format Specificati
 header, a JSON chunk padded with spaces and a BIN chunk padded with zeros, both to 4 bytes.
 Positions are float32, indices uint16 or uint32; no normals, so viewers shade flat (spec
 section 3.7.2.1). Byte-identical across builds: no clock, fixed order, `jsonout` numbers.
+
+Node names are the URDF link names, exactly (issue 12). A loader may rename one on load: trimesh
+turns a node called "world" (the ECN 2R's root link) into "world_1", its own root being "world".
 """
 
 from __future__ import annotations
@@ -139,12 +142,17 @@ def document(robot: Robot) -> tuple[dict, bytes]:
         {
             "name": f"{robot.name}_y_up",
             "rotation": list(Y_UP),
-            "children": [1],
             "extras": {"note": "turns the kit's Z-up frames into glTF's Y-up"},
         },
-        {"name": robot.root, "children": []},
     ]
-    index = {robot.root: 1}
+    # A floating base has no URDF link for the world (urdf.py): its base link hangs on the Y-up
+    # node directly, so the GLB's nodes are exactly the URDF's links (issue 12).
+    if robot.floating_joint is None:
+        nodes[0]["children"] = [1]
+        nodes.append({"name": robot.root, "children": []})
+    else:
+        nodes[0]["children"] = []
+    index = {robot.root: len(nodes) - 1}
 
     def attach(parent: str, node: dict) -> None:
         nodes.append(node)

@@ -32,6 +32,14 @@ def _mesh_name(link: str, index: int | None = None) -> str:
 
 def _primitive(parent: ET.Element, shape: Shape, name: str) -> None:
     attrs = {"name": name, "class": shape.geom_class or "collision", "type": shape.kind}
+    if shape.kind == "capsule":
+        # end points, as the Asimov page writes its capsules (001_71a395c46b8a5939.txt,
+        # "Capsule-Based Collision": fromto="0 0 0 0 0 -0.25")
+        half = rpy_matrix(shape.rpy) @ np.array([0.0, 0.0, shape.length / 2])
+        ends = np.concatenate([np.asarray(shape.xyz) - half, np.asarray(shape.xyz) + half])
+        attrs.update(size=num(shape.radius), fromto=vec(ends))
+        sub(parent, "geom", attrs)
+        return
     if shape.kind == "box":
         attrs["size"] = vec(np.asarray(shape.size) / 2)
     elif shape.kind == "sphere":
@@ -79,8 +87,10 @@ def _geoms(body: ET.Element, link: Link) -> None:
             },
         )
     if link.collision_primitives or link.collision_method == "primitives":
+        # one primitive: `LINK_collision`, the Asimov page's name (left_knee_link_collision)
+        single = len(link.collision_primitives) == 1
         for i, shape in enumerate(link.collision_primitives):
-            _primitive(body, shape, f"{link.name}_collision_{i:02d}")
+            _primitive(body, shape, f"{link.name}_collision" + ("" if single else f"_{i:02d}"))
     elif link.collision:
         for i in range(len(link.collision)):
             sub(

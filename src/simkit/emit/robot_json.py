@@ -187,6 +187,8 @@ def document(robot: Robot, reports: SimReports) -> dict:
             "published_estimated": list(robot.published_estimated),
         },
     }
+    if reports.self_collision is not None:
+        doc["geometry"]["self_collision"] = reports.self_collision
     _generalise(robot, doc)
     doc.update(_products(robot, reports))
     return doc

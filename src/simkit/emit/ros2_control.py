@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from simkit.derive.ros2_control import controllers, joints
+from simkit.derive.ros2_control import controller_base, controllers, joints
 from simkit.emit.docs import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
@@ -137,8 +137,8 @@ def _context(robot: Robot) -> dict:
         "joints": [
             {
                 "name": j.name,
-                "position": f"{j.name}_position_controller",
-                "effort": f"{j.name}_effort_controller",
+                "position": f"{controller_base(j.name)}_position_controller",
+                "effort": f"{controller_base(j.name)}_effort_controller",
             }
             for j in joints(robot)
         ],

@@ -228,6 +228,9 @@ class SimReports:
     freefall: dict | None = None
     #: simulate/benchmark.py: {cycle name: inverse-dynamics torques and forcerange fractions}
     benchmark_torques: dict | None = None
+    #: simulate/self_collision.py: robot.json geometry.self_collision (clearance at home,
+    #: collision-free ranges, self-contact fraction of random configurations)
+    self_collision: dict | None = None
 
 
 @dataclass(frozen=True)

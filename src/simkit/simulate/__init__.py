@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from simkit.model.robot import Robot, SimReports
-from simkit.simulate import benchmark, freefall
+from simkit.simulate import benchmark, freefall, self_collision
 
 
 def simulate_all(kit_dir: Path, robot: Robot) -> SimReports:
@@ -15,4 +15,5 @@ def simulate_all(kit_dir: Path, robot: Robot) -> SimReports:
     return SimReports(
         freefall=freefall.run(kit_dir, robot),
         benchmark_torques=benchmark.run(kit_dir, robot),
+        self_collision=self_collision.run(kit_dir, robot),
     )

@@ -19,16 +19,23 @@ from simkit.model.robot import Robot
 PAYLOAD_BODY = "simkit_payload"
 
 
-def inverse_dynamics_model(mjcf_text: str, parent_body: str, payload: dict):
-    """The kit's MJCF with its geometry left out (contacts play no part; every body has an
-    explicit inertial) and the payload attached to `parent_body` as one body."""
+def inverse_dynamics_model(
+    mjcf_text: str, parent_body: str, payload: dict, assets: dict[str, bytes] | None = None
+):
+    """The kit's MJCF with the payload attached to `parent_body` as one body.
+
+    With `assets` (mesh bytes keyed by path under the MJCF's meshdir) the model keeps its
+    geometry and contacts, as the kit's MJCF has them on (issue 12): a trajectory that drives
+    links into each other then needs the contact forces too. Without, the geometry is left out
+    (every body has an explicit inertial) and contacts are off: enough for poses at rest."""
     import mujoco
 
     root = ET.fromstring(mjcf_text)
-    for parent in list(root.iter()):
-        for child in list(parent):
-            if child.tag == "geom" or (child.tag == "mesh" and parent.tag == "asset"):
-                parent.remove(child)
+    if assets is None:
+        for parent in list(root.iter()):
+            for child in list(parent):
+                if child.tag == "geom" or (child.tag == "mesh" and parent.tag == "asset"):
+                    parent.remove(child)
     body = next(b for b in root.iter("body") if b.get("name") == parent_body)
     if payload["mass"] > 0:
         holder = ET.SubElement(body, "body", name=PAYLOAD_BODY, pos=vec(payload["com_link"]))
@@ -39,7 +46,10 @@ def inverse_dynamics_model(mjcf_text: str, parent_body: str, payload: dict):
             mass=vec([payload["mass"]]),
             diaginertia=vec(payload["inertia_diag"]),
         )
-    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    text = ET.tostring(root, encoding="unicode")
+    if assets is not None:
+        return mujoco.MjModel.from_xml_string(text, assets)
+    model = mujoco.MjModel.from_xml_string(text)
     model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
     return model
 
@@ -52,13 +62,15 @@ def kit_model_check(
     q: np.ndarray,
     qd: np.ndarray,
     qdd: np.ndarray,
+    assets: dict[str, bytes],
 ) -> dict:
     """Largest |torque| (N m) each joint of the MJCF needs to follow (q, qd, qdd) with the
-    payload (MuJoCo inverse dynamics: mass matrix, bias, damping), and its fraction of the
+    payload (MuJoCo inverse dynamics: mass matrix, bias, damping and contact forces, with the
+    MJCF's own collision geometry and excludes; `assets`: its meshes), and its fraction of the
     actuator's forcerange."""
     import mujoco
 
-    model = inverse_dynamics_model(mjcf_text, parent_body, payload)
+    model = inverse_dynamics_model(mjcf_text, parent_body, payload, assets)
     data = mujoco.MjData(model)
     qadr = [int(model.jnt_qposadr[model.joint(n).id]) for n in joints]
     dadr = [int(model.jnt_dofadr[model.joint(n).id]) for n in joints]
@@ -73,6 +85,7 @@ def kit_model_check(
         "max_torque": list(peak),
         "forcerange": list(limit),
         "fraction": list(peak / limit),
+        "contacts": "on: the MJCF's collision geometry and contact excludes, as in the kit",
     }
 
 
@@ -82,9 +95,24 @@ def run(kit_dir: Path, robot: Robot) -> dict | None:
     if not samples:
         return None
     text = (kit_dir / layout.mjcf(robot.name)).read_text(encoding="utf-8")
+    assets = mesh_assets(kit_dir)
     return {
         name: kit_model_check(
-            text, samples["joints"], samples["link"], c["payload"], c["q"], c["qd"], c["qdd"]
+            text,
+            samples["joints"],
+            samples["link"],
+            c["payload"],
+            c["q"],
+            c["qd"],
+            c["qdd"],
+            assets,
         )
         for name, c in samples["cycles"].items()
     }
+
+
+def mesh_assets(kit_dir: Path) -> dict[str, bytes]:
+    """The kit's mesh files keyed by their path under `meshes/` (the MJCF's meshdir), so the
+    MJCF compiles from a string with its collision geometry."""
+    meshes = kit_dir / "meshes"
+    return {f.relative_to(meshes).as_posix(): f.read_bytes() for f in sorted(meshes.rglob("*.stl"))}
