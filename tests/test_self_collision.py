@@ -159,9 +159,8 @@ def test_an_unflagged_colliding_ik_solution_fails(rosie_1000, tmp_path):
 
 @slow
 def test_derived_depth_flags_listed_solutions(rosie_1000):
-    from simkit.self_contact import depth_function
-
     from simkit.derive.ik_cases import _listed
+    from simkit.derive.self_contact import depth_function
     from simkit.model.ik import Solution
     from simkit.pipeline import model_from_spec
 
@@ -179,12 +178,11 @@ def test_derived_depth_flags_listed_solutions(rosie_1000):
 
 @slow
 def test_kit_model_check_runs_with_contacts(rosie_1000):
-    from simkit.derive.benchmark import kit_model_check
+    from simkit.simulate.benchmark import kit_model_check, mesh_assets
 
     kit = Kit.open(rosie_1000.kit_dir)
     text = kit.path(kit.mjcf).read_text()
-    meshes = kit.path("meshes")
-    assets = {f.relative_to(meshes).as_posix(): f.read_bytes() for f in meshes.rglob("*.stl")}
+    assets = mesh_assets(kit.root)
     payload = {"mass": 0.0}
     names = [f"J{i}" for i in range(1, 7)]
     zero = np.zeros((1, 6))

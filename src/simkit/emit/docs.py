@@ -8,6 +8,7 @@ from functools import cache
 import jinja2
 import numpy as np
 
+from simkit.derive.ros2_control import controllers
 from simkit.emit import mjcf_world
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
@@ -132,7 +133,6 @@ def _gazebo(robot: Robot) -> dict | None:
     """Controllers of launch/gazebo.launch.py per `control:=` mode, when the kit has it."""
     if robot.ros2_control is None:
         return None
-    from simkit.emit.ros2_control import controllers
 
     names = controllers(robot)
     return {

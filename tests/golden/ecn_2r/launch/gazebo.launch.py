@@ -31,8 +31,8 @@ PACKAGE_MESHES = 'filename="package://' + PACKAGE + '/meshes/'
 CONTROLLERS_PLACEHOLDER = "$(find ecn_2r_description)/config/controllers.yaml"
 BROADCASTER = "joint_state_broadcaster"
 CONTROLLERS_BY_MODE = {
-    "position": ["joint_1_position_controller", "joint_2_position_controller"],
-    "effort": ["joint_1_effort_controller", "joint_2_effort_controller"],
+    "position": ["joint1_position_controller", "joint2_position_controller"],
+    "effort": ["joint1_effort_controller", "joint2_effort_controller"],
 }
 
 
