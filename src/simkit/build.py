@@ -72,10 +72,34 @@ def model_from_spec(
 
 
 #: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
-EMIT_LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core", "jinja2")
+EMIT_LIBRARIES = (
+    "numpy",
+    "manifold3d",
+    "trimesh",
+    "coacd",
+    "mujoco",
+    "usd-core",
+    "jinja2",
+    "cadquery-ocp",
+)
 
 
-def _emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes]:
+def _emitters(usd_format: str, step: bool) -> dict:
+    """The emitter set for these options (`step`: False drops `step/NAME.step`)."""
+    from functools import partial
+
+    from simkit.emit import robot_json
+
+    emitters = {**EMITTERS, "usd": usd.emitter(usd_format)}
+    if not step:
+        del emitters["step"]
+        emitters["robot_json"] = partial(robot_json.emit, step=False)
+    return emitters
+
+
+def _emit_cached(
+    robot: Robot, usd_format: str, cache: Cache, step: bool = True
+) -> dict[str, bytes]:
     """`emit_all`, reusing the files of an earlier build of an identical model.
 
     Emitters are pure functions of the model and the templates (no clock, no randomness), so
@@ -99,14 +123,14 @@ def _emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes
         "emit",
         1,
         [digest(robot).encode(), code_digest().encode(), *template_bytes],
-        {"usd_format": usd_format},
+        {"usd_format": usd_format, "step": step},
         EMIT_LIBRARIES,
     )
     stored = cache.get("emit", key)
     if stored is not None:
         blob = stored["blob"].tobytes()
         return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
-    files = emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)})
+    files = emit_all(robot, _emitters(usd_format, step))
     index, offset = [], 0
     for path, data in files.items():
         index.append([path, offset, offset + len(data)])
@@ -144,14 +168,16 @@ def build(
     cache: Cache | None = None,
     jobs: int | None = None,
     usd_format: str = "usda",
+    step: bool = True,
 ) -> BuildResult:
     """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`;
-    `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`."""
+    `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`; `step`: False leaves
+    out `step/NAME.step` (and the Open CASCADE import it costs)."""
     say = progress or (lambda _msg: None)
     cache = Cache.at() if cache is None else cache
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
-    files = _emit_cached(robot, usd_format, cache)
+    files = _emit_cached(robot, usd_format, cache, step)
     out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
     staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))

@@ -17,6 +17,7 @@ from simkit.check.motion_check import check_motion
 from simkit.check.mujoco_check import check_hold, check_models, check_parameters
 from simkit.check.published import check_published
 from simkit.check.ros_check import check_ros
+from simkit.check.step_check import check_step
 from simkit.check.urdf_check import check_urdf
 from simkit.check.usd_check import check_usd
 
@@ -35,6 +36,7 @@ CHECKS: dict[str, Check] = {
     "usd": check_usd,
     "motion": check_motion,
     "freefall": check_freefall,
+    "step": check_step,
 }
 
 
@@ -52,7 +54,16 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
 
 
 #: Libraries whose behaviour the findings depend on (part of the cache key).
-CHECK_LIBRARIES = ("numpy", "scipy", "mujoco", "yourdfpy", "trimesh", "usd-core", "manifold3d")
+CHECK_LIBRARIES = (
+    "numpy",
+    "scipy",
+    "mujoco",
+    "yourdfpy",
+    "trimesh",
+    "usd-core",
+    "manifold3d",
+    "cadquery-ocp",
+)
 
 
 def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache) -> list[Finding]:

@@ -19,6 +19,7 @@ from simkit.emit import (
     ros2,
     ros2_control,
     srdf,
+    step,
     urdf,
     usd,
     validation,
@@ -42,6 +43,7 @@ EMITTERS: dict[str, Emitter] = {
     "glb": glb.emit,
     "ros2_control": ros2_control.emit,
     "validation": validation.emit,
+    "step": step.emit,
 }
 
 
