@@ -106,8 +106,8 @@ def _boolean(first: TopoDS_Shape, others: list[TopoDS_Shape], cut: bool) -> Topo
     """`first` fused with (or, `cut`, minus) all of `others` in one Boolean operation, with
     coplanar and coaxial faces merged afterwards (ShapeUpgrade_UnifySameDomain)."""
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
-    from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
     from OCP.collections import List_TopoDS_Shape
+    from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 
     if not others:
         return first
@@ -130,12 +130,12 @@ def _boolean(first: TopoDS_Shape, others: list[TopoDS_Shape], cut: bool) -> Topo
 
 def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
     """A closed triangle mesh (m) as one sewn, faceted solid (mm)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace as MakeFace
     from OCP.BRepBuilderAPI import (
         BRepBuilderAPI_MakePolygon,
         BRepBuilderAPI_MakeSolid,
         BRepBuilderAPI_Sewing,
     )
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace as MakeFace
     from OCP.gp import gp_Pnt
     from OCP.TopAbs import TopAbs_SHELL
     from OCP.TopExp import TopExp_Explorer

@@ -63,9 +63,7 @@ def _keys(bodies: dict[int, str], tail: set[int]) -> dict[int, str]:
 def canonical_tail(text: str) -> str:
     """`text` with the presentation tail renumbered in content order (see module doc)."""
     head, entities, foot = split(text)
-    first = next(
-        (i for i, (_, body) in enumerate(entities) if body.startswith(TAIL_START)), None
-    )
+    first = next((i for i, (_, body) in enumerate(entities) if body.startswith(TAIL_START)), None)
     if first is None:
         return text
     bodies = dict(entities)

@@ -155,9 +155,11 @@ def check_step(kit: Kit) -> list[Finding]:
             f"file has {', '.join(f'{n}: {len(s)}' for n, s in sorted(parts.items())) or 'none'})",
         ),
     ]
-    invalid = [n for n, solids in sorted(parts.items()) if any(
-        not BRepCheck_Analyzer(s).IsValid() for s in solids
-    )]
+    invalid = [
+        n
+        for n, solids in sorted(parts.items())
+        if any(not BRepCheck_Analyzer(s).IsValid() for s in solids)
+    ]
     findings.append(
         require("step.brepcheck", not invalid, f"every solid passes BRepCheck ({invalid or 'all'})")
     )
