@@ -128,33 +128,71 @@ def _boolean(first: TopoDS_Shape, others: list[TopoDS_Shape], cut: bool) -> Topo
     return unify.Shape()
 
 
+def _components(faces: np.ndarray) -> list[np.ndarray]:
+    """The faces of each vertex-connected piece of a mesh (by vertex index), in first-face
+    order: manifold3d keeps solids that only touch as separate shells."""
+    parent = list(range(int(faces.max()) + 1))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b, c in faces.tolist():
+        for other in (b, c):
+            ra, rb = root(a), root(other)
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)
+    labels = np.array([root(int(f[0])) for f in faces])
+    return [faces[labels == label] for label in dict.fromkeys(labels.tolist())]
+
+
+def mesh_solid(mesh: Mesh) -> TopoDS_Shape:
+    """A closed mesh (m) as one solid (mm): one faceted solid per connected piece, fused."""
+    faces = np.asarray(mesh.faces, dtype=int)
+    pieces = [faceted_solid(Mesh.of(mesh.vertices, part)) for part in _components(faces)]
+    return _boolean(pieces[0], pieces[1:], cut=False)
+
+
 def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
-    """A closed triangle mesh (m) as one sewn, faceted solid (mm)."""
+    """A closed, connected triangle mesh (m, outward winding) as one faceted solid (mm).
+
+    The shell is sewn by the mesh's own topology: one shared edge per mesh edge (vertex
+    indices, not coordinates), so a mesh that touches itself at an edge or a vertex still
+    gives the right shell, and each face keeps the triangle's outward winding.
+    """
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace as MakeFace
-    from OCP.BRepBuilderAPI import (
-        BRepBuilderAPI_MakePolygon,
-        BRepBuilderAPI_MakeSolid,
-        BRepBuilderAPI_Sewing,
-    )
-    from OCP.gp import gp_Pnt
-    from OCP.TopAbs import TopAbs_SHELL
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+    from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid, TopoDS_Wire
 
     verts = np.asarray(mesh.vertices, dtype=float) * MM
-    sewing = BRepBuilderAPI_Sewing(1e-6)
-    for tri in np.asarray(mesh.faces):
-        a, b, c = (gp_Pnt(*(float(v) for v in verts[i])) for i in tri)
-        polygon = BRepBuilderAPI_MakePolygon(a, b, c, True)
-        if polygon.IsDone():
-            sewing.Add(MakeFace(polygon.Wire(), True).Face())
-    sewing.Perform()
-    explorer = TopExp_Explorer(sewing.SewedShape(), TopAbs_SHELL)
-    maker = BRepBuilderAPI_MakeSolid()
-    while explorer.More():
-        maker.Add(TopoDS.Shell_s(explorer.Current()))
-        explorer.Next()
-    return maker.Solid()
+    points = [BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, v))).Vertex() for v in verts]
+    edges: dict[tuple[int, int], Any] = {}
+    builder = BRep_Builder()
+    shell = TopoDS_Shell()
+    builder.MakeShell(shell)
+    for tri in np.asarray(mesh.faces, dtype=int):
+        wire = TopoDS_Wire()
+        builder.MakeWire(wire)
+        for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
+            key = (min(a, b), max(a, b))
+            if key not in edges:
+                edges[key] = BRepBuilderAPI_MakeEdge(points[key[0]], points[key[1]]).Edge()
+            builder.Add(wire, edges[key] if a < b else edges[key].Reversed())
+        a, b, c = verts[tri]
+        normal = np.cross(b - a, c - a)
+        if np.linalg.norm(normal) <= 1e-12:
+            continue  # a zero-area sliver: its edges are shared by its neighbours already
+        plane = gp_Pln(gp_Pnt(*map(float, a)), gp_Dir(*map(float, normal)))
+        builder.Add(shell, MakeFace(plane, wire, True).Face())
+    shell.Closed(True)
+    solid = TopoDS_Solid()
+    builder.MakeSolid(solid)
+    builder.Add(solid, shell)
+    return solid
 
 
 def link_shape(link: Link) -> TopoDS_Shape | None:
@@ -162,7 +200,7 @@ def link_shape(link: Link) -> TopoDS_Shape | None:
     if not link.shapes:
         return None
     if any(s.kind == "mesh" for s in link.shapes):
-        return faceted_solid(link.solid) if link.solid is not None else None
+        return mesh_solid(link.solid) if link.solid is not None else None
     add = [primitive_shape(s) for s in link.shapes if not s.subtract]
     cut = [primitive_shape(s) for s in link.shapes if s.subtract]
     solid = _boolean(add[0], add[1:], cut=False)
