@@ -5,6 +5,7 @@ Open CASCADE writes the geometry in a stable order, but it walks its colour styl
 hash map keyed by memory addresses, so the STYLED_ITEM ... COLOUR_RGB tail comes out in a
 different order from one run to the next. `canonical_tail` renumbers that tail by content
 (a Merkle key per entity), which makes rebuilds byte-identical without changing meaning.
+`canonical` also renumbers the assembly occurrences, whose ids come from a process counter.
 """
 
 from __future__ import annotations
@@ -58,6 +59,18 @@ def _keys(bodies: dict[int, str], tail: set[int]) -> dict[int, str]:
             keys[eid] = "@" + hashlib.sha256(text.encode()).hexdigest()[:16]
             stack.pop()
     return keys
+
+
+NAUO = re.compile(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\('\d+'")
+
+
+def canonical(text: str) -> str:
+    """`text` with the colour tail in content order and the assembly occurrences numbered
+    1, 2, ... in file order (OCCT numbers them from a counter that lives as long as the
+    process, so a second export in one process would differ)."""
+    count = iter(range(1, 1 << 30))
+    text = NAUO.sub(lambda _m: f"NEXT_ASSEMBLY_USAGE_OCCURRENCE('{next(count)}'", text)
+    return canonical_tail(text)
 
 
 def canonical_tail(text: str) -> str:

@@ -18,7 +18,7 @@ import numpy as np
 from simkit import __version__, brep, layout
 from simkit.kinematics import forward
 from simkit.model import Robot
-from simkit.stepfile import canonical_tail
+from simkit.stepfile import canonical
 
 #: FILE_NAME fields that OCCT fills from the clock, the user and its own version.
 ORIGINATING_SYSTEM = f"simkit {__version__}"
@@ -117,7 +117,7 @@ def step_bytes(robot: Robot) -> bytes:
         if writer.Write(str(path)) != IFSelect_ReturnStatus.IFSelect_RetDone:
             raise RuntimeError(f"{robot.name}: Open CASCADE could not write the STEP file")
         text = path.read_text(encoding="utf-8").replace("\r\n", "\n")
-    return canonical_tail(text).encode("utf-8")
+    return canonical(text).encode("utf-8")
 
 
 def emit(robot: Robot) -> dict[str, bytes]:
