@@ -10,10 +10,12 @@ import numpy as np
 
 from simkit import layout
 from simkit.emit import mjcf_world
+from simkit.emit.step import step_origin
 from simkit.fmt import num
 from simkit.kinematics import chain, quat_wxyz, rpy_matrix
 from simkit.model import Robot
 from simkit.resources import data_dir
+from simkit.solids import CIRCULAR_SEGMENTS
 
 
 @cache
@@ -73,6 +75,9 @@ def context(robot: Robot) -> dict:
         "demo_q": demo,
         "demo_pose": demo_pose,
         "sources": list(robot.sources),
+        "step": layout.step(robot.name),
+        "step_origin": step_origin(robot),
+        "segments": CIRCULAR_SEGMENTS,
         **_floating(robot),
         **_fk_snippet(robot),
     }
