@@ -8,6 +8,7 @@ collision pieces, and visual and collision triangles.
 
     python scripts/bench.py                      # every robots/rosie_*.yaml
     python scripts/bench.py rosie_1000 tests/specs/collision_mix.yaml --warm 5 --json out.json
+    python scripts/bench.py rosie_1000 --compare-step 3   # what the STEP assembly adds
 """
 
 from __future__ import annotations
@@ -26,7 +27,9 @@ from pathlib import Path
 LOG = re.compile(r"collision (\S+): (\w+), (\d+) pieces, ([\d.]+) s")
 
 
-def _build(target: str, out: Path, cache: Path, jobs: int | None) -> tuple[float, str]:
+def _build(
+    target: str, out: Path, cache: Path, jobs: int | None, extra: tuple[str, ...] = ()
+) -> tuple[float, str]:
     cmd = [
         sys.executable,
         "-m",
@@ -40,6 +43,7 @@ def _build(target: str, out: Path, cache: Path, jobs: int | None) -> tuple[float
     ]
     if jobs:
         cmd += ["--jobs", str(jobs)]
+    cmd += list(extra)
     start = time.perf_counter()
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - start
@@ -52,11 +56,13 @@ def _triangles(path: Path) -> int:
     return int.from_bytes(path.read_bytes()[80:84], "little")
 
 
-def bench(target: str, warm_runs: int, jobs: int | None) -> dict:
+def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] = ()) -> dict:
     with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
         root = Path(tmp)
-        cold, log = _build(target, root / "out", root / "cache", jobs)
-        warm = [_build(target, root / "out", root / "cache", jobs)[0] for _ in range(warm_runs)]
+        cold, log = _build(target, root / "out", root / "cache", jobs, extra)
+        warm = [
+            _build(target, root / "out", root / "cache", jobs, extra)[0] for _ in range(warm_runs)
+        ]
         coacd = sum(float(m[3]) for m in LOG.findall(log) if m[1] == "coacd")
         kit = next((root / "out").glob("*_description"))
         doc = json.loads((kit / "robot.json").read_text())
@@ -95,6 +101,14 @@ def main() -> None:
     parser.add_argument("--warm", type=int, default=3, help="warm rebuilds per robot (median)")
     parser.add_argument("--jobs", type=int, default=None, help="passed to simkit build --jobs")
     parser.add_argument("--json", type=Path, default=None, help="also write the rows here")
+    parser.add_argument(
+        "--compare-step",
+        type=int,
+        default=0,
+        metavar="N",
+        help="also time N cold+warm rounds with and without --no-step (alternating) and "
+        "print what the STEP assembly adds (median of the N rounds)",
+    )
     args = parser.parse_args()
     targets = args.targets
     if not targets:
@@ -115,8 +129,45 @@ def main() -> None:
             f"{r['max_hull_volume_ratio']:.3f} | {r['max_visual_to_collision_mm']:.2f} | "
             f"{r['visual_triangles']} | {r['collision_triangles']} |"
         )
+    if args.compare_step:
+        rows += _compare_step(targets, args.compare_step, args.warm, args.jobs)
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2) + "\n")
+
+
+def _compare_step(targets: list[str], rounds: int, warm: int, jobs: int | None) -> list[dict]:
+    """Cold and warm build time with the STEP assembly and with `--no-step`, alternating the
+    two in each round so that load on the machine hits both alike; medians over rounds."""
+    out = []
+    print(
+        "\n| robot | cold s (STEP) | cold s (--no-step) | STEP adds cold s | warm s (STEP) "
+        "| warm s (--no-step) | STEP adds warm s |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for target in targets:
+        runs: dict[str, list[dict]] = {"step": [], "no_step": []}
+        for _ in range(rounds):
+            runs["step"].append(bench(target, warm, jobs))
+            runs["no_step"].append(bench(target, warm, jobs, ("--no-step",)))
+        med = {
+            k: {m: statistics.median(r[m] for r in v) for m in ("cold_s", "warm_s")}
+            for k, v in runs.items()
+        }
+        row = {
+            "robot": runs["step"][0]["robot"],
+            "rounds": rounds,
+            "step": med["step"],
+            "no_step": med["no_step"],
+            "step_adds_cold_s": med["step"]["cold_s"] - med["no_step"]["cold_s"],
+            "step_adds_warm_s": med["step"]["warm_s"] - med["no_step"]["warm_s"],
+        }
+        print(
+            f"| {row['robot']} | {med['step']['cold_s']:.2f} | {med['no_step']['cold_s']:.2f} | "
+            f"{row['step_adds_cold_s']:+.2f} | {med['step']['warm_s']:.2f} | "
+            f"{med['no_step']['warm_s']:.2f} | {row['step_adds_warm_s']:+.2f} |"
+        )
+        out.append(row)
+    return out
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from simkit import brep, layout
 from simkit.build import build, model_from_spec
 from simkit.check import run_checks
 from simkit.check.step_check import check_step, zero_pose_frames
+from simkit.diff import diff_kits
 from simkit.emit import step
 from simkit.model import Shape
 from simkit.solids import to_mesh
@@ -183,6 +184,11 @@ def test_step_check_fails_on_a_link_moved_5_mm(rosie_1000, tmp_path):
     found = _findings(kit)
     assert not found["step.bounds"].ok and "link_6" in found["step.bounds"].detail
     assert found["step.products"].ok
+    report = diff_kits(rosie_1000.kit_dir, kit)
+    moved_links = {c.name for c in report.changes if c.kind == "step" and c.field == "bbox"}
+    assert moved_links == {"link_6"}
+    change = next(c for c in report.changes if c.kind == "step" and c.field == "bbox")
+    assert np.allclose(np.subtract(change.new, change.old), [5, 0, 0, 5, 0, 0], atol=1e-3)
 
 
 @pytest.mark.slow
