@@ -133,15 +133,25 @@ def check_step(kit: Kit) -> list[Finding]:
     """The STEP assembly against robot.json and the visual meshes (see module doc)."""
     entry = kit.doc.get("geometry", {}).get("step")
     if entry is None:
-        return [require("step.file", True, "no STEP in this kit (built with --no-step)")]
+        stray = (
+            sorted(p.name for p in kit.path("step").glob("*")) if kit.path("step").is_dir() else []
+        )
+        return [
+            require(
+                "step.file",
+                not stray,
+                f"robot.json: no STEP (--no-step); step/ holds {stray or 'nothing'}",
+            )
+        ]
     from OCP.BRepCheck import BRepCheck_Analyzer
-
-    from simkit.brep import bounds, volume
 
     parts, text = read_step(kit.path(entry["file"]))
     meshes = {link["name"]: link["mesh"]["visual"] for link in kit.doc["links"]}
     expected = sorted(name for name, path in meshes.items() if path)
     poses = zero_pose_frames(kit.doc, entry["origin"])
+    counts = {name: len(solids) for name, solids in parts.items()}
+    wrong = [f"{n}: {counts.get(n, 0)} solids" for n in expected if counts.get(n, 0) != 1]
+    wrong += [f"{n}: not a link with geometry" for n in sorted(set(counts) - set(expected))]
     findings = [
         require(
             "step.schema",
@@ -150,9 +160,9 @@ def check_step(kit: Kit) -> list[Finding]:
         ),
         require(
             "step.products",
-            sorted(parts) == expected and all(len(parts[n]) == 1 for n in expected),
+            not wrong,
             f"one solid per link with geometry, named as the link ({len(expected)} links; "
-            f"file has {', '.join(f'{n}: {len(s)}' for n, s in sorted(parts.items())) or 'none'})",
+            f"wrong: {', '.join(wrong) or 'none'})",
         ),
     ]
     invalid = [
@@ -163,31 +173,35 @@ def check_step(kit: Kit) -> list[Finding]:
     findings.append(
         require("step.brepcheck", not invalid, f"every solid passes BRepCheck ({invalid or 'all'})")
     )
-    worst_volume, worst_bounds, bad = 0.0, 0.0, []
-    for name in expected:
-        if len(parts.get(name, [])) != 1:
-            continue
-        ref_volume, ref_box = _stl_in_origin(kit, meshes[name], poses[name])
+    return findings + _against_meshes(kit, parts, meshes, poses, entry["origin"])
+
+
+def _against_meshes(kit: Kit, parts: dict, meshes: dict, poses: dict, origin: str) -> list:
+    """Volume and bounding box of each link's solid against its visual STL (mm)."""
+    from simkit.brep import bounds, volume
+
+    worst_volume, worst_bounds, off_volume, off_bounds = 0.0, 0.0, [], []
+    for name, path in sorted(meshes.items()):
+        if not path or len(parts.get(name, [])) != 1:
+            continue  # step.products reports it
+        ref_volume, ref_box = _stl_in_origin(kit, path, poses[name])
         dv = abs(volume(parts[name][0]) / ref_volume - 1.0)
         db = float(np.abs(bounds(parts[name][0]) - ref_box).max())
         worst_volume, worst_bounds = max(worst_volume, dv), max(worst_bounds, db)
-        if dv > VOLUME_TOL or db > BOUNDS_TOL:
-            bad.append(name)
-    findings.append(
+        off_volume += [name] if dv > VOLUME_TOL else []
+        off_bounds += [name] if db > BOUNDS_TOL else []
+    return [
         require(
             "step.volume",
-            worst_volume <= VOLUME_TOL,
+            not off_volume,
             f"each solid's volume within {VOLUME_TOL:.0%} of its visual STL's "
-            f"(worst {worst_volume:.3%})",
-        )
-    )
-    findings.append(
+            f"(worst {worst_volume:.3%}; off: {', '.join(off_volume) or 'none'})",
+        ),
         require(
             "step.bounds",
-            worst_bounds <= BOUNDS_TOL,
+            not off_bounds,
             f"each solid's bounding box within {BOUNDS_TOL:g} mm of its visual STL's in "
-            f"{entry['origin']} at the zero pose (worst {worst_bounds:.3g} mm; off: "
-            f"{', '.join(bad) or 'none'})",
-        )
-    )
-    return findings
+            f"{origin} at the zero pose (worst {worst_bounds:.3g} mm; off: "
+            f"{', '.join(off_bounds) or 'none'})",
+        ),
+    ]
