@@ -40,8 +40,11 @@ CHECKS: dict[str, Check] = {
 }
 
 
-#: Checks that run in a second process next to the others (overlap.py): Open CASCADE.
-OVERLAPPED_CHECKS = ("step",)
+#: Checks that run in a second process next to the others (overlap.py), when the kit holds
+#: their file: the STEP check's Open CASCADE import and B-rep analysis.
+OVERLAPPED_CHECKS: dict[str, Callable[[Kit], bool]] = {
+    "step": lambda kit: kit.path("step").is_dir(),
+}
 
 
 def _run_one(name: str, check: Check, kit: Kit) -> list[Finding]:
@@ -63,8 +66,8 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
     with Overlap() as worker:
         side = {
             n: worker.submit(_run_one, n, checks[n], Kit(kit.root))
-            for n in OVERLAPPED_CHECKS
-            if n in checks
+            for n, worth in OVERLAPPED_CHECKS.items()
+            if n in checks and worth(kit)
         }
         found = {n: _run_one(n, c, kit) for n, c in checks.items() if n not in side}
         found.update({n: future.result() for n, future in side.items()})
