@@ -17,6 +17,7 @@ import argparse
 import json
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -24,6 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
+#: CPU seconds (user + system, the build and its worker processes) of each `_build`, in order.
+CPU: list[float] = []
 LOG = re.compile(r"collision (\S+): (\w+), (\d+) pieces, ([\d.]+) s")
 
 
@@ -44,9 +47,12 @@ def _build(
     if jobs:
         cmd += ["--jobs", str(jobs)]
     cmd += list(extra)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU.append(sum(getattr(after, f) - getattr(before, f) for f in ("ru_utime", "ru_stime")))
     if done.returncode != 0:
         raise SystemExit(f"{target}: build failed:\n{done.stderr}")
     return wall, done.stderr
@@ -60,9 +66,11 @@ def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] 
     with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
         root = Path(tmp)
         cold, log = _build(target, root / "out", root / "cache", jobs, extra)
+        cold_cpu = CPU[-1]
         warm = [
             _build(target, root / "out", root / "cache", jobs, extra)[0] for _ in range(warm_runs)
         ]
+        warm_cpu = statistics.median(CPU[-warm_runs:])
         coacd = sum(float(m[3]) for m in LOG.findall(log) if m[1] == "coacd")
         kit = next((root / "out").glob("*_description"))
         doc = json.loads((kit / "robot.json").read_text())
@@ -80,6 +88,8 @@ def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] 
         "cold_s": cold,
         "warm_s": statistics.median(warm),
         "warm_runs_s": warm,
+        "cold_cpu_s": cold_cpu,
+        "warm_cpu_s": warm_cpu,
         "coacd_links": sum(r["method"] == "coacd" for r in reports),
         "coacd_s": coacd,
         "coacd_share": coacd / cold,
@@ -150,7 +160,10 @@ def _compare_step(targets: list[str], rounds: int, warm: int, jobs: int | None) 
             runs["step"].append(bench(target, warm, jobs))
             runs["no_step"].append(bench(target, warm, jobs, ("--no-step",)))
         med = {
-            k: {m: statistics.median(r[m] for r in v) for m in ("cold_s", "warm_s")}
+            k: {
+                m: statistics.median(r[m] for r in v)
+                for m in ("cold_s", "warm_s", "cold_cpu_s", "warm_cpu_s")
+            }
             for k, v in runs.items()
         }
         row = {
@@ -160,11 +173,15 @@ def _compare_step(targets: list[str], rounds: int, warm: int, jobs: int | None) 
             "no_step": med["no_step"],
             "step_adds_cold_s": med["step"]["cold_s"] - med["no_step"]["cold_s"],
             "step_adds_warm_s": med["step"]["warm_s"] - med["no_step"]["warm_s"],
+            "step_adds_cold_cpu_s": med["step"]["cold_cpu_s"] - med["no_step"]["cold_cpu_s"],
+            "step_adds_warm_cpu_s": med["step"]["warm_cpu_s"] - med["no_step"]["warm_cpu_s"],
         }
+        s, n = med["step"], med["no_step"]
         print(
-            f"| {row['robot']} | {med['step']['cold_s']:.2f} | {med['no_step']['cold_s']:.2f} | "
-            f"{row['step_adds_cold_s']:+.2f} | {med['step']['warm_s']:.2f} | "
-            f"{med['no_step']['warm_s']:.2f} | {row['step_adds_warm_s']:+.2f} |"
+            f"| {row['robot']} | {s['cold_s']:.2f} / {n['cold_s']:.2f} | "
+            f"{row['step_adds_cold_s']:+.2f} | {row['step_adds_cold_cpu_s']:+.2f} | "
+            f"{s['warm_s']:.2f} / {n['warm_s']:.2f} | {row['step_adds_warm_s']:+.2f} | "
+            f"{row['step_adds_warm_cpu_s']:+.2f} |"
         )
         out.append(row)
     return out
