@@ -97,28 +97,6 @@ def _emitters(usd_format: str, step: bool) -> dict:
     return emitters
 
 
-#: Emitters that run in a second process next to the others (overlap.py): Open CASCADE.
-OVERLAPPED_EMITTERS = ("step",)
-
-
-def _emit_overlapped(robot: Robot, emitters: dict) -> dict[str, bytes]:
-    """`emit_all`, with the OVERLAPPED_EMITTERS in a worker process meanwhile."""
-    from simkit.overlap import Overlap
-
-    side = {name: emitters[name] for name in OVERLAPPED_EMITTERS if name in emitters}
-    if not side:
-        return emit_all(robot, emitters)
-    rest = {name: fn for name, fn in emitters.items() if name not in side}
-    with Overlap() as worker:
-        future = worker.submit(emit_all, robot, side)
-        files = emit_all(robot, rest)
-        extra = future.result()
-    clash = sorted(set(files) & set(extra))
-    if clash:
-        raise RuntimeError(f"two emitters write {clash[0]}")
-    return dict(sorted({**files, **extra}.items()))
-
-
 def _emit_cached(
     robot: Robot, usd_format: str, cache: Cache, step: bool = True
 ) -> dict[str, bytes]:
@@ -152,7 +130,7 @@ def _emit_cached(
     if stored is not None:
         blob = stored["blob"].tobytes()
         return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
-    files = _emit_overlapped(robot, _emitters(usd_format, step))
+    files = emit_all(robot, _emitters(usd_format, step))
     index, offset = [], 0
     for path, data in files.items():
         index.append([path, offset, offset + len(data)])

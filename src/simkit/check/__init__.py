@@ -40,38 +40,17 @@ CHECKS: dict[str, Check] = {
 }
 
 
-#: Checks that run in a second process next to the others (overlap.py), when the kit holds
-#: their file: the STEP check's Open CASCADE import and B-rep analysis.
-OVERLAPPED_CHECKS: dict[str, Callable[[Kit], bool]] = {
-    "step": lambda kit: kit.path("step").is_dir(),
-}
-
-
-def _run_one(name: str, check: Check, kit: Kit) -> list[Finding]:
-    """One check's findings; a damaged kit (missing or unreadable file) fails, no traceback."""
-    try:
-        return check(kit)
-    except Exception as exc:
-        why = " ".join(f"{type(exc).__name__}: {exc}".split())
-        return [require(f"{name}.error", False, f"the {name} check cannot run: {why}")]
-
-
 def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Finding]:
-    """Every finding for the kit at `kit_dir`, in a stable order (the OVERLAPPED_CHECKS run
-    in a worker process meanwhile; their findings keep their place in the order)."""
-    from simkit.overlap import Overlap
-
+    """Every finding for the kit at `kit_dir`, in a stable order."""
     kit = Kit.open(kit_dir)
-    checks = checks or CHECKS
-    with Overlap() as worker:
-        side = {
-            n: worker.submit(_run_one, n, checks[n], Kit(kit.root))
-            for n, worth in OVERLAPPED_CHECKS.items()
-            if n in checks and worth(kit)
-        }
-        found = {n: _run_one(n, c, kit) for n, c in checks.items() if n not in side}
-        found.update({n: future.result() for n, future in side.items()})
-    return [finding for name in checks for finding in found[name]]
+    findings: list[Finding] = []
+    for name, check in (checks or CHECKS).items():
+        try:
+            findings.extend(check(kit))
+        except Exception as exc:  # a damaged kit (missing or unreadable file): fail, no traceback
+            why = " ".join(f"{type(exc).__name__}: {exc}".split())
+            findings.append(require(f"{name}.error", False, f"the {name} check cannot run: {why}"))
+    return findings
 
 
 #: Libraries whose behaviour the findings depend on (part of the cache key).

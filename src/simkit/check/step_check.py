@@ -62,6 +62,8 @@ def read_step(path) -> tuple[dict[str, list], str]:
     XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 0.001)
     reader = STEPCAFControl_Reader()
     reader.SetNameMode(True)
+    for off in (reader.SetColorMode, reader.SetLayerMode, reader.SetPropsMode):
+        off(False)  # names and shapes are all the check reads
     if reader.ReadFile(str(path)) != IFSelect_ReturnStatus.IFSelect_RetDone:
         raise ValueError(f"{path}: Open CASCADE cannot read this STEP file")
     if not reader.Transfer(doc):
