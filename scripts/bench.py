@@ -147,11 +147,12 @@ def main() -> None:
 
 def _compare_step(targets: list[str], rounds: int, warm: int, jobs: int | None) -> list[dict]:
     """Cold and warm build time with the STEP assembly and with `--no-step`, alternating the
-    two in each round so that load on the machine hits both alike; medians over rounds."""
+    two in each round so that load on the machine hits both alike; medians over rounds. CPU
+    seconds (the build process and any workers) depend far less on other load than wall time."""
     out = []
     print(
-        "\n| robot | cold s (STEP) | cold s (--no-step) | STEP adds cold s | warm s (STEP) "
-        "| warm s (--no-step) | STEP adds warm s |"
+        "\n| robot | cold s (STEP / --no-step) | STEP adds cold s | cold CPU s added | "
+        "warm s (STEP / --no-step) | STEP adds warm s | warm CPU s added |"
     )
     print("|---|---|---|---|---|---|---|")
     for target in targets:
