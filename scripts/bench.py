@@ -119,8 +119,15 @@ def main() -> None:
         help="also time N cold+warm rounds with and without --no-step (alternating) and "
         "print what the STEP assembly adds (median of the N rounds)",
     )
+    parser.add_argument(
+        "--step-parts", action="store_true", help="only time the parts of the STEP work"
+    )
     args = parser.parse_args()
     targets = args.targets
+    if args.step_parts:
+        for target in targets:
+            _step_parts(target)
+        return
     if not targets:
         from simkit.resources import robot_names
 
@@ -143,6 +150,35 @@ def main() -> None:
         rows += _compare_step(targets, args.compare_step, args.warm, args.jobs)
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2) + "\n")
+
+
+def _step_parts(target: str) -> None:
+    """CPU seconds of each part of the STEP work for one robot, in this process: the OCP
+    import, the exact link solids, the whole emitter (solids + translate + write) and the
+    check of a freshly built kit."""
+    from simkit.build import build, model_from_spec
+
+    with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
+        kit = build(target, Path(tmp), check=False).kit_dir
+        robot = model_from_spec(target)
+        start = time.process_time()
+        import OCP.OCP  # noqa: F401
+
+        parts = {"OCP import": time.process_time() - start}
+        from simkit import brep
+        from simkit.check.kit import Kit
+        from simkit.check.step_check import check_step
+        from simkit.emit import step
+
+        for name, job in (
+            ("link solids", lambda: [brep.link_shape(link) for link in robot.links]),
+            ("STEP emitter", lambda: step.step_bytes(robot)),
+            ("STEP check", lambda: check_step(Kit.open(kit))),
+        ):
+            start = time.process_time()
+            job()
+            parts[name] = time.process_time() - start
+    print(f"{target}: " + ", ".join(f"{k} {v:.2f} s" for k, v in parts.items()) + " (CPU)")
 
 
 def _compare_step(targets: list[str], rounds: int, warm: int, jobs: int | None) -> list[dict]:
