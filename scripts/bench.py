@@ -8,6 +8,7 @@ collision pieces, and visual and collision triangles.
 
     python scripts/bench.py                      # every robots/rosie_*.yaml
     python scripts/bench.py rosie_1000 tests/specs/collision_mix.yaml --warm 5 --json out.json
+    python scripts/bench.py rosie_1000 --compare-step 3   # what the STEP assembly adds
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import argparse
 import json
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -23,10 +25,14 @@ import tempfile
 import time
 from pathlib import Path
 
+#: CPU seconds (user + system, the build and its worker processes) of each `_build`, in order.
+CPU: list[float] = []
 LOG = re.compile(r"collision (\S+): (\w+), (\d+) pieces, ([\d.]+) s")
 
 
-def _build(target: str, out: Path, cache: Path, jobs: int | None) -> tuple[float, str]:
+def _build(
+    target: str, out: Path, cache: Path, jobs: int | None, extra: tuple[str, ...] = ()
+) -> tuple[float, str]:
     cmd = [
         sys.executable,
         "-m",
@@ -40,9 +46,13 @@ def _build(target: str, out: Path, cache: Path, jobs: int | None) -> tuple[float
     ]
     if jobs:
         cmd += ["--jobs", str(jobs)]
+    cmd += list(extra)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU.append(sum(getattr(after, f) - getattr(before, f) for f in ("ru_utime", "ru_stime")))
     if done.returncode != 0:
         raise SystemExit(f"{target}: build failed:\n{done.stderr}")
     return wall, done.stderr
@@ -52,11 +62,15 @@ def _triangles(path: Path) -> int:
     return int.from_bytes(path.read_bytes()[80:84], "little")
 
 
-def bench(target: str, warm_runs: int, jobs: int | None) -> dict:
+def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] = ()) -> dict:
     with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
         root = Path(tmp)
-        cold, log = _build(target, root / "out", root / "cache", jobs)
-        warm = [_build(target, root / "out", root / "cache", jobs)[0] for _ in range(warm_runs)]
+        cold, log = _build(target, root / "out", root / "cache", jobs, extra)
+        cold_cpu = CPU[-1]
+        warm = [
+            _build(target, root / "out", root / "cache", jobs, extra)[0] for _ in range(warm_runs)
+        ]
+        warm_cpu = statistics.median(CPU[-warm_runs:])
         coacd = sum(float(m[3]) for m in LOG.findall(log) if m[1] == "coacd")
         kit = next((root / "out").glob("*_description"))
         doc = json.loads((kit / "robot.json").read_text())
@@ -74,6 +88,8 @@ def bench(target: str, warm_runs: int, jobs: int | None) -> dict:
         "cold_s": cold,
         "warm_s": statistics.median(warm),
         "warm_runs_s": warm,
+        "cold_cpu_s": cold_cpu,
+        "warm_cpu_s": warm_cpu,
         "coacd_links": sum(r["method"] == "coacd" for r in reports),
         "coacd_s": coacd,
         "coacd_share": coacd / cold,
@@ -95,8 +111,23 @@ def main() -> None:
     parser.add_argument("--warm", type=int, default=3, help="warm rebuilds per robot (median)")
     parser.add_argument("--jobs", type=int, default=None, help="passed to simkit build --jobs")
     parser.add_argument("--json", type=Path, default=None, help="also write the rows here")
+    parser.add_argument(
+        "--compare-step",
+        type=int,
+        default=0,
+        metavar="N",
+        help="also time N cold+warm rounds with and without --no-step (alternating) and "
+        "print what the STEP assembly adds (median of the N rounds)",
+    )
+    parser.add_argument(
+        "--step-parts", action="store_true", help="only time the parts of the STEP work"
+    )
     args = parser.parse_args()
     targets = args.targets
+    if args.step_parts:
+        for target in targets:
+            _step_parts(target)
+        return
     if not targets:
         from simkit.kitio.resources import robot_names
 
@@ -115,8 +146,82 @@ def main() -> None:
             f"{r['max_hull_volume_ratio']:.3f} | {r['max_visual_to_collision_mm']:.2f} | "
             f"{r['visual_triangles']} | {r['collision_triangles']} |"
         )
+    if args.compare_step:
+        rows += _compare_step(targets, args.compare_step, args.warm, args.jobs)
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2) + "\n")
+
+
+def _step_parts(target: str) -> None:
+    """CPU seconds of each part of the STEP work for one robot, in this process: the OCP
+    import, the exact link solids, the whole emitter (solids + translate + write) and the
+    check of a freshly built kit."""
+    from simkit.pipeline import build, model_from_spec
+
+    with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
+        kit = build(target, Path(tmp), check=False).kit_dir
+        robot = model_from_spec(target)
+        start = time.process_time()
+        import OCP.OCP  # noqa: F401
+
+        parts = {"OCP import": time.process_time() - start}
+        from simkit.check.kit import Kit
+        from simkit.check.step import check_step
+        from simkit.derive import brep
+        from simkit.emit import step
+
+        for name, job in (
+            ("link solids", lambda: [brep.link_shape(link) for link in robot.links]),
+            ("STEP emitter", lambda: step.step_bytes(robot)),
+            ("STEP check", lambda: check_step(Kit.open(kit))),
+        ):
+            start = time.process_time()
+            job()
+            parts[name] = time.process_time() - start
+    print(f"{target}: " + ", ".join(f"{k} {v:.2f} s" for k, v in parts.items()) + " (CPU)")
+
+
+def _compare_step(targets: list[str], rounds: int, warm: int, jobs: int | None) -> list[dict]:
+    """Cold and warm build time with the STEP assembly and with `--no-step`, alternating the
+    two in each round so that load on the machine hits both alike; medians over rounds. CPU
+    seconds (the build process and any workers) depend far less on other load than wall time."""
+    out = []
+    print(
+        "\n| robot | cold s (STEP / --no-step) | STEP adds cold s | cold CPU s added | "
+        "warm s (STEP / --no-step) | STEP adds warm s | warm CPU s added |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for target in targets:
+        runs: dict[str, list[dict]] = {"step": [], "no_step": []}
+        for _ in range(rounds):
+            runs["step"].append(bench(target, warm, jobs))
+            runs["no_step"].append(bench(target, warm, jobs, ("--no-step",)))
+        med = {
+            k: {
+                m: statistics.median(r[m] for r in v)
+                for m in ("cold_s", "warm_s", "cold_cpu_s", "warm_cpu_s")
+            }
+            for k, v in runs.items()
+        }
+        row = {
+            "robot": runs["step"][0]["robot"],
+            "rounds": rounds,
+            "step": med["step"],
+            "no_step": med["no_step"],
+            "step_adds_cold_s": med["step"]["cold_s"] - med["no_step"]["cold_s"],
+            "step_adds_warm_s": med["step"]["warm_s"] - med["no_step"]["warm_s"],
+            "step_adds_cold_cpu_s": med["step"]["cold_cpu_s"] - med["no_step"]["cold_cpu_s"],
+            "step_adds_warm_cpu_s": med["step"]["warm_cpu_s"] - med["no_step"]["warm_cpu_s"],
+        }
+        s, n = med["step"], med["no_step"]
+        print(
+            f"| {row['robot']} | {s['cold_s']:.2f} / {n['cold_s']:.2f} | "
+            f"{row['step_adds_cold_s']:+.2f} | {row['step_adds_cold_cpu_s']:+.2f} | "
+            f"{s['warm_s']:.2f} / {n['warm_s']:.2f} | {row['step_adds_warm_s']:+.2f} | "
+            f"{row['step_adds_warm_cpu_s']:+.2f} |"
+        )
+        out.append(row)
+    return out
 
 
 if __name__ == "__main__":

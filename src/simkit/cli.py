@@ -59,6 +59,11 @@ def main() -> None:
     show_default=True,
     help="USD as text (diffable) or binary crate.",
 )
+@click.option(
+    "--no-step",
+    is_flag=True,
+    help="Leave out step/NAME.step (the STEP assembly; saves the Open CASCADE time).",
+)
 def build(
     targets: tuple[str, ...],
     out_dir: Path,
@@ -68,6 +73,7 @@ def build(
     cache_dir: Path | None,
     no_cache: bool,
     usd_format: str,
+    no_step: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
     from simkit.kitio.cache import Cache
@@ -90,6 +96,7 @@ def build(
                 cache=cache,
                 jobs=jobs,
                 usd_format=usd_format,
+                step=not no_step,
             )
         except SimkitError as exc:
             _fail(exc)

@@ -3,7 +3,8 @@
 Compares two kit folders or zips: joints (limits, speeds, torques, drive, origin, axis),
 links (mass, CoM, inertia), links and joints added or removed (all from robot.json), meshes
 whose bytes changed (volume, bounding box, triangle count), each link's number of convex
-collision pieces, other robot.json keys that changed, and files added, removed or changed.
+collision pieces, each STEP solid's volume and bounding box (diff_step.py), other robot.json
+keys that changed, and files added, removed or changed.
 Markdown for people, JSON for machines. Two kits are equal when every file is byte-identical.
 """
 
@@ -53,7 +54,7 @@ COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.stl$")
 
 @dataclass(frozen=True)
 class Change:
-    """One semantic change: `kind` is joint, link, mesh, collision or robot_json; `change`
+    """One semantic change: `kind` is joint, link, mesh, collision, step or robot_json; `change`
     is modified, added or removed."""
 
     kind: str
@@ -202,6 +203,10 @@ def diff_files(
         "link", _by_name(a.get("links", [])), _by_name(b.get("links", [])), LINK_FIELDS
     )
     report.changes += _meshes(old, new)
+    if any(p.endswith(".step") and p in new and old[p] != new[p] for p in old):
+        from simkit.diff_step import step_changes
+
+        report.changes += step_changes(old, new, Change)
     pieces_a, pieces_b = _pieces(old), _pieces(new)
     for link in sorted(set(pieces_a) | set(pieces_b)):
         if pieces_a.get(link, 0) != pieces_b.get(link, 0):
@@ -261,6 +266,7 @@ TITLES = {
     "link": "Links",
     "mesh": "Meshes",
     "collision": "Collision pieces",
+    "step": "STEP solids (assembly frame, mm)",
     "robot_json": "Other robot.json entries",
 }
 

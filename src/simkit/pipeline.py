@@ -75,7 +75,16 @@ def model_from_spec(
 
 
 #: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
-EMIT_LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core", "jinja2")
+EMIT_LIBRARIES = (
+    "numpy",
+    "manifold3d",
+    "trimesh",
+    "coacd",
+    "mujoco",
+    "usd-core",
+    "jinja2",
+    "cadquery-ocp",
+)
 #: Libraries the simulate stage's figures depend on.
 SIMULATE_LIBRARIES = ("numpy", "scipy", "mujoco", "matplotlib")
 
@@ -107,7 +116,15 @@ def _template_bytes() -> list[bytes]:
     ]
 
 
-def emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes]:
+def _emitters(usd_format: str, step: bool) -> dict:
+    """The model emitters for these options (`step`: False drops `step/NAME.step`)."""
+    emitters = {**EMITTERS, "usd": usd.emitter(usd_format)}
+    if not step:
+        del emitters["step"]
+    return emitters
+
+
+def emit_cached(robot: Robot, usd_format: str, cache: Cache, step: bool = True) -> dict[str, bytes]:
     """The emit stage, reusing the files of an earlier build of an identical model. Emitters
     are pure functions of the model and the templates, so a hit runs no emitter (a warm
     rebuild does not even import pxr)."""
@@ -115,25 +132,28 @@ def emit_cached(robot: Robot, usd_format: str, cache: Cache) -> dict[str, bytes]
         cache,
         "emit",
         [digest(robot).encode(), *_template_bytes()],
-        lambda: emit_all(robot, {**EMITTERS, "usd": usd.emitter(usd_format)}),
+        lambda: emit_all(robot, _emitters(usd_format, step)),
         _pack_files,
         _unpack_files,
         EMIT_LIBRARIES,
-        {"usd_format": usd_format},
+        {"usd_format": usd_format, "step": step},
     )
 
 
-def simulate_cached(kit_dir: Path, robot: Robot, cache: Cache) -> dict[str, bytes]:
+def simulate_cached(
+    kit_dir: Path, robot: Robot, cache: Cache, step: bool = True
+) -> dict[str, bytes]:
     """The simulate stage on the staged kit, then the report emitters. The staged files are
     a pure function of the model, so the model's digest (and the templates) keys both."""
     return cached_stage(
         cache,
         "simulate",
         [digest(robot).encode(), *_template_bytes()],
-        lambda: emit_reports(robot, simulate_all(kit_dir, robot)),
+        lambda: emit_reports(robot, simulate_all(kit_dir, robot), step=step),
         _pack_files,
         _unpack_files,
         (*EMIT_LIBRARIES, *SIMULATE_LIBRARIES),
+        {"step": step},
     )
 
 
@@ -165,14 +185,16 @@ def build(
     cache: Cache | None = None,
     jobs: int | None = None,
     usd_format: str = "usda",
+    step: bool = True,
 ) -> BuildResult:
     """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`;
-    `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`."""
+    `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`; `step`: False leaves
+    out `step/NAME.step` (and the Open CASCADE import it costs)."""
     say = progress or (lambda _msg: None)
     cache = Cache.at() if cache is None else cache
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
-    files = emit_cached(robot, usd_format, cache)
+    files = emit_cached(robot, usd_format, cache, step)
     out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
     staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))
@@ -180,7 +202,7 @@ def build(
         staged_kit = staging / kit_name
         write_tree(staged_kit, files)
         say("simulate")
-        reports = simulate_cached(staged_kit, robot, cache)
+        reports = simulate_cached(staged_kit, robot, cache, step)
         clash = sorted(set(files) & set(reports))
         if clash:
             raise RuntimeError(f"a model emitter and a report emitter both write {clash[0]}")

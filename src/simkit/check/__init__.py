@@ -19,6 +19,7 @@ from simkit.check.mujoco import check_hold, check_models, check_parameters
 from simkit.check.published_numbers import check_published
 from simkit.check.ros import check_ros
 from simkit.check.self_collision import check_self_collision
+from simkit.check.step import check_step
 from simkit.check.urdf import check_urdf
 from simkit.check.usd import check_usd
 from simkit.kitio.cache import Cache, cached_stage, decode_json, encode_json
@@ -39,6 +40,7 @@ CHECKS: dict[str, Check] = {
     "motion": check_motion,
     "freefall": check_freefall,
     "self_collision": check_self_collision,
+    "step": check_step,
 }
 
 
@@ -56,7 +58,16 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
 
 
 #: Libraries whose behaviour the findings depend on (part of the cache key).
-CHECK_LIBRARIES = ("numpy", "scipy", "mujoco", "yourdfpy", "trimesh", "usd-core", "manifold3d")
+CHECK_LIBRARIES = (
+    "numpy",
+    "scipy",
+    "mujoco",
+    "yourdfpy",
+    "trimesh",
+    "usd-core",
+    "manifold3d",
+    "cadquery-ocp",
+)
 
 
 def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache: Cache) -> list[Finding]:

@@ -20,13 +20,13 @@ from simkit.emit import (
     ros2,
     ros2_control,
     srdf,
+    step,
     urdf,
     usd,
 )
 from simkit.model.robot import Robot, SimReports
 
 Emitter = Callable[[Robot], dict[str, bytes]]
-ReportEmitter = Callable[[Robot, SimReports], dict[str, bytes]]
 
 EMITTERS: dict[str, Emitter] = {
     "meshes": meshes.emit,
@@ -41,13 +41,7 @@ EMITTERS: dict[str, Emitter] = {
     "motion_files": motion_files.emit,
     "glb": glb.emit,
     "ros2_control": ros2_control.emit,
-}
-
-
-#: Emitters of what the simulate stage measured: they run after it, on its reports.
-REPORT_EMITTERS: dict[str, ReportEmitter] = {
-    "robot_json": robot_json.emit,
-    "freefall_files": freefall_files.emit,
+    "step": step.emit,
 }
 
 
@@ -56,9 +50,15 @@ def emit_all(robot: Robot, emitters: dict[str, Emitter] | None = None) -> dict[s
     return _collect({name: emitter(robot) for name, emitter in (emitters or EMITTERS).items()})
 
 
-def emit_reports(robot: Robot, reports: SimReports) -> dict[str, bytes]:
-    """Run every report emitter (after the simulate stage)."""
-    return _collect({name: emit(robot, reports) for name, emit in REPORT_EMITTERS.items()})
+def emit_reports(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, bytes]:
+    """The report emitters, robot.json and the free-fall files, after the simulate stage, on
+    its reports; `step`: whether the kit has a STEP assembly (robot.json `geometry.step`)."""
+    return _collect(
+        {
+            "robot_json": robot_json.emit(robot, reports, step=step),
+            "freefall_files": freefall_files.emit(robot, reports),
+        }
+    )
 
 
 def _collect(outputs: dict[str, dict[str, bytes]]) -> dict[str, bytes]:

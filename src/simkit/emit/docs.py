@@ -9,7 +9,9 @@ import jinja2
 import numpy as np
 
 from simkit.derive.ros2_control import controllers
+from simkit.derive.solids import CIRCULAR_SEGMENTS
 from simkit.emit import mjcf_world
+from simkit.emit.step import step_origin
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.kitio.resources import data_dir
@@ -74,6 +76,9 @@ def context(robot: Robot) -> dict:
         "demo_q": demo,
         "demo_pose": demo_pose,
         "sources": list(robot.sources),
+        "step": layout.step(robot.name),
+        "step_origin": step_origin(robot),
+        "segments": CIRCULAR_SEGMENTS,
         **_floating(robot),
         **_fk_snippet(robot),
         **_page_extras(robot),

@@ -241,6 +241,8 @@ def digest(value: object) -> str:
             h.update(b">")
         elif hasattr(v, "model_dump"):
             feed(v.model_dump())  # type: ignore[union-attr]
+        elif isinstance(v, np.generic):  # a numpy scalar is its value: JSON round trips agree
+            feed(v.item())
         elif isinstance(v, np.ndarray):
             h.update(f"a{v.dtype.str}{v.shape}".encode())
             h.update(np.ascontiguousarray(v).tobytes())

@@ -98,3 +98,8 @@ def freefall_plot() -> str:
 def relative(from_file: str, to_file: str) -> str:
     """Path of `to_file` as seen from the folder of `from_file` (e.g. `../meshes/...`)."""
     return posixpath.relpath(to_file, posixpath.dirname(from_file) or ".")
+
+
+def step(robot: str) -> str:
+    """The STEP AP214 assembly (emit/step.py), millimetres, origin base_link."""
+    return f"step/{robot}.step"
