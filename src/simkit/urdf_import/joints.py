@@ -57,12 +57,13 @@ def joint_spec(source: Source, joint, report: Report, load: tuple[float, float])
                 spec[key] = value
     mimic = joint.find("mimic")
     if mimic is not None:
-        spec["mimic"] = {
-            "joint": mimic.get("joint"),
-            "multiplier": floats(source, mimic, "multiplier", 1, "1"),
-            "offset": floats(source, mimic, "offset", 1, "0"),
-        }
-        spec["actuated"] = False
+        report.dropped(
+            source,
+            mimic,
+            f"mimic of '{mimic.get('joint')}' (multiplier {mimic.get('multiplier', '1')}, "
+            f"offset {mimic.get('offset', '0')}): simkit has no coupled joints yet; "
+            "imported as an independent joint",
+        )
     if estimated:
         spec["estimated"] = estimated
     return spec
