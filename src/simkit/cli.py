@@ -190,6 +190,12 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
 @click.option("--strict", is_flag=True, help="Refuse instead of estimating missing values.")
 @click.option("--floating-base", is_flag=True, help="The root link moves freely (legged).")
 @click.option(
+    "--hull",
+    "hull_collision",
+    is_flag=True,
+    help="Non-convex collision meshes: the visual's convex hull instead of CoACD (fast).",
+)
+@click.option(
     "--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path)
 )
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
@@ -199,6 +205,7 @@ def import_urdf(
     package_dirs: tuple[Path, ...],
     strict: bool,
     floating_base: bool,
+    hull_collision: bool,
     out_dir: Path,
     quiet: bool,
 ) -> None:
@@ -206,7 +213,9 @@ def import_urdf(
     from simkit.urdf_import import import_robot
 
     try:
-        done = import_robot(path, out_dir, name, package_dirs, strict, floating_base)
+        done = import_robot(
+            path, out_dir, name, package_dirs, strict, floating_base, hull_collision
+        )
     except SimkitError as exc:
         _fail(exc)
         return

@@ -42,8 +42,11 @@ def import_robot(
     package_dirs: tuple[Path, ...] = (),
     strict: bool = False,
     floating: bool = False,
+    hull_collision: bool = False,
 ) -> Imported:
-    """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use."""
+    """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
+    `hull_collision`: links whose URDF collision is non-convex meshes collide with their
+    visual solid's convex hull instead of CoACD pieces (fast; reported per link)."""
     from simkit.urdf_import import convert, meshes, source, writer
 
     name = name or robot_name(path)
@@ -55,7 +58,7 @@ def import_robot(
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
         stage = Path(tmp)
         mesh_writer = meshes.MeshWriter(stage)
-        spec = convert.convert(doc, name, mesh_writer, report, floating)
+        spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
         if strict and report.problems:
             first = report.problems[0]
             first.more = len(report.problems) - 1

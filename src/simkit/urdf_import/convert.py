@@ -101,7 +101,12 @@ def materials_of(source: Source) -> dict[str, tuple]:
 
 
 def convert(
-    source: Source, name: str, writer: MeshWriter, report: Report, floating: bool
+    source: Source,
+    name: str,
+    writer: MeshWriter,
+    report: Report,
+    floating: bool,
+    hull_collision: bool = False,
 ) -> dict:
     """The spec dict for the whole robot."""
     for element in source.root:
@@ -129,7 +134,10 @@ def convert(
             frame.update({k: js[k] for k in ("xyz", "rpy") if k in js})
             spec_frames.append(frame)
             continue
-        spec_links.append(link_spec(source, links[link_name], writer, report, materials, colours))
+        spec_links.append(link_spec(
+                source, links[link_name], writer, report, materials, colours, hull_collision
+            )
+        )
         if link_name in by_child:
             load = _load(source, link_name, links, kids, by_child)
             spec_joints.append(joint_spec(source, by_child[link_name], report, load))

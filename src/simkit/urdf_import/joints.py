@@ -78,10 +78,12 @@ def _limits(
     if kind != "continuous":
         lower = None if limit is None else limit.get("lower")
         upper = None if limit is None else limit.get("upper")
-        if lower is None and upper is None:
+        same = lower is not None and upper is not None and _num(lower) == _num(upper)
+        if (lower is None and upper is None) or same:
             span = math.pi if kind == "revolute" else 0.1
             unit = "rad" if kind == "revolute" else "m"
-            report.estimated(source, element, f"no position limits: +-{span:g} {unit}")
+            why = "lower == upper (no range)" if same else "no position limits"
+            report.estimated(source, element, f"{why}: +-{span:g} {unit}")
             out["lower"], out["upper"] = -span, span
             estimated += ["lower", "upper"]
         else:
@@ -105,3 +107,10 @@ def _limits(
         estimated.append("effort_peak")
     out["effort_peak"] = effort
     return out
+
+
+def _num(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None

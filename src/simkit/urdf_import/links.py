@@ -114,6 +114,7 @@ def link_spec(
     report: Report,
     materials: dict[str, tuple],
     colours: dict[tuple, str],
+    hull_collision: bool = False,
 ) -> dict:
     """The spec dict of one link. `colours` maps rgba -> material name (filled here)."""
     name = link.get("name")
@@ -151,7 +152,11 @@ def link_spec(
     if rgba is not None:
         colours.setdefault(rgba, f"colour_{len(colours)}")
         spec["material"] = colours[rgba]
-    spec.update(_collision(collisions, infos))
+    chosen = _collision(collisions, infos)
+    if hull_collision and chosen["collision"] == "auto":
+        chosen = {"collision": "mesh"}
+        report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
+    spec.update(chosen)
     return spec
 
 
