@@ -38,7 +38,12 @@ def test_arm_keeps_the_urdf_numbers(tmp_path):
     assert [j.type for j in spec.joints] == ["fixed", "revolute", "prismatic", "continuous"]
     turn = joints["turn"]
     assert (turn.lower, turn.upper, turn.effort_peak, turn.max_velocity) == (-2.5, 2.5, 30, 2.0)
-    assert (turn.damping, turn.friction, turn.rpy, turn.xyz) == (0.5, 0.1, (0, 0, 0.1), (0, 0, 0.02))
+    assert (turn.damping, turn.friction, turn.rpy, turn.xyz) == (
+        0.5,
+        0.1,
+        (0, 0, 0.1),
+        (0, 0, 0.02),
+    )
     assert joints["spin"].axis == (0, 1, 0) and joints["slide"].axis == (1, 0, 0)
     links = {link.name: link for link in spec.links}
     assert links["base_link"].mass == 2.0 and links["base_link"].com == (0, 0, 0.02)

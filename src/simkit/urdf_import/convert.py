@@ -72,7 +72,9 @@ def _load(source, name, links, kids, by_child) -> tuple[float, float]:
     for child in kids.get(name, []):
         sub_mass, sub_arm = _load(source, child, links, kids, by_child)
         xyz = by_child[child].find("origin")
-        offset = 0.0 if xyz is None else float(np.linalg.norm(floats(source, xyz, "xyz", 3, "0 0 0")))
+        offset = (
+            0.0 if xyz is None else float(np.linalg.norm(floats(source, xyz, "xyz", 3, "0 0 0")))
+        )
         mass += sub_mass
         arm = max(arm, offset + sub_arm)
     return mass, max(arm, 0.1)
@@ -111,7 +113,9 @@ def convert(
     """The spec dict for the whole robot."""
     for element in source.root:
         if isinstance(element.tag, str) and element.tag not in TOP:
-            report.dropped(source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)")
+            report.dropped(
+                source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
+            )
     links, by_child, root = _tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)
@@ -134,9 +138,8 @@ def convert(
             frame.update({k: js[k] for k in ("xyz", "rpy") if k in js})
             spec_frames.append(frame)
             continue
-        spec_links.append(link_spec(
-                source, links[link_name], writer, report, materials, colours, hull_collision
-            )
+        spec_links.append(
+            link_spec(source, links[link_name], writer, report, materials, colours, hull_collision)
         )
         if link_name in by_child:
             load = _load(source, link_name, links, kids, by_child)

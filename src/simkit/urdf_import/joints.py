@@ -102,7 +102,9 @@ def _limits(
         mass, arm = load
         effort = float(f"{max(1.0, 2.0 * mass * G * (1.0 if kind == 'prismatic' else arm)):.3g}")
         report.estimated(
-            source, element, f"no effort limit: {effort:g}, twice the static load of what it carries"
+            source,
+            element,
+            f"no effort limit: {effort:g}, twice the static load of what it carries",
         )
         estimated.append("effort_peak")
     out["effort_peak"] = effort

@@ -80,7 +80,7 @@ def inertial(source: Source, link, report: Report) -> dict:
         report.estimated(
             source,
             tag if tag is not None else element,
-            f"zero inertia: a solid sphere of {DENSITY:g} kg/m^3 with the mass ({moment:.3g} kg m^2)",
+            f"zero inertia: a {DENSITY:g} kg/m^3 solid sphere of that mass ({moment:.3g} kg m^2)",
         )
         out["inertia"] = {"ixx": moment, "iyy": moment, "izz": moment}
         out["estimated"] = ["inertia"]
