@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import resource
 import site
 import subprocess
 import sys
@@ -34,8 +35,15 @@ def corpus() -> Path:
     sys.exit("example-robot-data is not installed (pip install example-robot-data==6.0.0)")
 
 
-def _run(args: list[str], timeout: float) -> tuple[int, str, float]:
-    start = time.perf_counter()
+def _cpu() -> float:
+    """CPU seconds (user + system) used by finished child processes so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _run(args: list[str], timeout: float) -> tuple[int, str, tuple[float, float]]:
+    """Exit code, last line of output, and (wall s, CPU s) of one simkit command."""
+    start, cpu = time.perf_counter(), _cpu()
     try:
         done = subprocess.run(
             [sys.executable, "-m", "simkit.cli", *args],
@@ -44,9 +52,9 @@ def _run(args: list[str], timeout: float) -> tuple[int, str, float]:
             timeout=timeout,
         )
     except subprocess.TimeoutExpired:
-        return 124, f"timed out after {timeout:.0f} s", time.perf_counter() - start
+        return 124, f"timed out after {timeout:.0f} s", (time.perf_counter() - start, 0.0)
     text = (done.stderr.strip().splitlines() or [""])[-1] if done.returncode else done.stdout
-    return done.returncode, text, time.perf_counter() - start
+    return done.returncode, text, (time.perf_counter() - start, _cpu() - cpu)
 
 
 def _first_failure(message: str) -> str:
@@ -65,7 +73,8 @@ def one(urdf: Path, root: Path, work: Path, timeout: float, coacd: bool) -> dict
     args += [] if coacd else ["--hull"]
     rc, text, _s = _run(args, timeout)
     if rc:
-        row["import"] = "error: " + text.removeprefix("simkit: error: ")[:120]
+        message = text.removeprefix("simkit: error: ").replace(str(root) + "/", "")
+        row["import"] = "error: " + message[:160]
         return row
     row["import"] = "ok"
     spec = work / "specs" / name / f"{name}.yaml"
@@ -87,10 +96,13 @@ def one(urdf: Path, root: Path, work: Path, timeout: float, coacd: bool) -> dict
 
 
 def table(rows: list[dict]) -> str:
-    head = "| robot | import | build | first failing check | cold s | warm s | links | CoACD |"
+    head = (
+        "| robot | import | build | first failing check | cold s (CPU s) | warm s (CPU s) "
+        "| links | CoACD |"
+    )
     lines = [head, "|---|---|---|---|---:|---:|---:|---:|"]
     for r in rows:
-        num = [f"{r[k]:.1f}" if r[k] is not None else "" for k in ("cold", "warm")]
+        num = [f"{r[k][0]:.1f} ({r[k][1]:.1f})" if r[k] else "" for k in ("cold", "warm")]
         share = f"{100 * r['coacd']:.0f} %" if r["coacd"] is not None else ""
         lines.append(
             f"| {r['robot']} | {r['import']} | {r['build']} | {r['failing']} | {num[0]} | "
@@ -136,7 +148,8 @@ def _save(md: Path, rows: list[dict], total: int) -> None:
         + "`"
         + done
         + ": import with `--hull` unless `--coacd`; cold = empty cache, warm = second build "
-        "with that cache; 2 cores shared with other work.\n\n" + table(rows)
+        "with that cache; wall seconds with CPU seconds (user + system, all processes) in "
+        "brackets, on 2 cores shared with other work.\n\n" + table(rows)
     )
 
 

@@ -193,7 +193,7 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
     "--hull",
     "hull_collision",
     is_flag=True,
-    help="Non-convex collision meshes: the visual's convex hull instead of CoACD (fast).",
+    help="Collision meshes: the visual's convex hull (one piece) instead of the URDF's.",
 )
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path))
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")

@@ -128,8 +128,10 @@ class LinkSpec(Strict):
     inertia: InertiaSpec | None = None
     material: str | None = None
     solid: tuple[Primitive, ...] = ()
-    collision: Literal["auto", "convex", "coacd", "primitives", "mesh"] = "auto"
+    collision: Literal["auto", "convex", "coacd", "primitives", "mesh", "given"] = "auto"
     collision_primitives: tuple[CollisionPrimitive, ...] = ()
+    #: `collision: given`: shapes (e.g. an imported URDF's collision meshes), one convex piece each
+    collision_shapes: tuple[Primitive, ...] = ()
     estimated: tuple[str, ...] = ()
     note: str | None = None
     #: keep a non-physical reported inertia on purpose (spec_sim.InertiaDecisionSpec)
@@ -155,6 +157,14 @@ class DriveSpec(Strict):
     efficiency: Annotated[float, Field(gt=0, le=1)] = 1.0
     gear_max_output_torque: PositiveFloat | None = None
     estimated: tuple[str, ...] = ()
+
+
+class MimicSpec(Strict):
+    """URDF `<mimic>`: this joint's value = multiplier * `joint`'s value + offset (rad or m)."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
 
 
 class JointSpec(Placed):
@@ -189,6 +199,8 @@ class JointSpec(Placed):
     kp: PositiveFloat | None = None
     kv: NonNegFloat | None = None
     mjcf_class: str | None = None
+    #: coupled to another joint (URDF <mimic>, MJCF <equality><joint>)
+    mimic: MimicSpec | None = None
     estimated: tuple[str, ...] = ()
 
     @model_validator(mode="after")

@@ -45,8 +45,8 @@ def import_robot(
     hull_collision: bool = False,
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
-    `hull_collision`: links whose URDF collision is non-convex meshes collide with their
-    visual solid's convex hull instead of CoACD pieces (fast; reported per link)."""
+    `hull_collision`: links whose URDF collision has meshes collide with their visual
+    solid's convex hull instead (one piece; reported per link)."""
     from simkit.urdf_import import convert, meshes, source, writer
 
     name = name or robot_name(path)

@@ -165,7 +165,12 @@ def convert(
     spec_links.sort(key=lambda link: rank.get(link["name"], -1))
     movable = [j for j in spec_joints if j["type"] not in ("fixed", "floating")]
     if movable:
-        spec["poses"] = {"home": [_home(j) for j in movable]}
+        home = {j["name"]: _home(j) for j in movable}
+        for j in movable:  # a mimic joint follows its leader
+            if "mimic" in j and j["mimic"]["joint"] in home:
+                m = j["mimic"]
+                home[j["name"]] = m["multiplier"] * home[m["joint"]] + m["offset"]
+        spec["poses"] = {"home": [home[j["name"]] for j in movable]}
     spec["links"] = spec_links
     spec["joints"] = spec_joints
     if spec_frames:

@@ -77,8 +77,9 @@ def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: 
             raise source.fail(shape, f"mesh scale must be non-zero, got {scale}")
         try:
             info = writer.write(path, scale)  # type: ignore[arg-type]
-        except ValueError as exc:
-            raise source.fail(shape, f"{uri}: {exc}") from None
+        except ValueError as exc:  # present but unreadable: left out, reported
+            report.dropped(source, shape, f"{what} {uri}: {exc}")
+            return None
         return {"shape": "mesh", "file": info.file, **pose}, info
     report.dropped(source, shape, f"{what} geometry <{kind}> is not supported")
     return None

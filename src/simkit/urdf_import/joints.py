@@ -57,13 +57,14 @@ def joint_spec(source: Source, joint, report: Report, load: tuple[float, float])
                 spec[key] = value
     mimic = joint.find("mimic")
     if mimic is not None:
-        report.dropped(
-            source,
-            mimic,
-            f"mimic of '{mimic.get('joint')}' (multiplier {mimic.get('multiplier', '1')}, "
-            f"offset {mimic.get('offset', '0')}): simkit has no coupled joints yet; "
-            "imported as an independent joint",
-        )
+        if not mimic.get("joint"):
+            raise source.fail(mimic, "mimic needs a 'joint'")
+        spec["mimic"] = {
+            "joint": mimic.get("joint"),
+            "multiplier": floats(source, mimic, "multiplier", 1, "1"),
+            "offset": floats(source, mimic, "offset", 1, "0"),
+        }
+        spec["actuated"] = False  # it follows its leader (MJCF equality), no servo of its own
     if estimated:
         spec["estimated"] = estimated
     return spec

@@ -153,22 +153,23 @@ def link_spec(
         colours.setdefault(rgba, f"colour_{len(colours)}")
         spec["material"] = colours[rgba]
     chosen = _collision(collisions, infos)
-    if hull_collision and chosen["collision"] == "auto":
+    if hull_collision and chosen["collision"] in ("given", "auto"):
         chosen = {"collision": "mesh"}
         report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
     spec.update(chosen)
     return spec
 
 
+#: up to this many collision elements are kept as the link's pieces (one convex hull each)
+MAX_GIVEN = 10
 PRIMITIVES = {"box", "cylinder", "sphere", "capsule"}
 
 
 def _collision(collisions: list[dict], infos: list) -> dict:
-    """Primitives stay primitives; one convex mesh becomes the visual's hull (`mesh`); other
-    meshes go to the cached CoACD path (`auto`); none means no collision geometry."""
+    """Primitives stay primitives; up to MAX_GIVEN meshes are kept, one convex piece each
+    (`given`); more go to the cached CoACD path (`auto`); none means no collision geometry."""
     if all(c["shape"] in PRIMITIVES for c in collisions):
         return {"collision": "primitives", "collision_primitives": collisions}
-    meshes = [i for i in infos if i is not None]
-    if len(collisions) == 1 and meshes and (meshes[0].convex or meshes[0].repair == "hull"):
-        return {"collision": "mesh"}
+    if len(collisions) <= MAX_GIVEN:
+        return {"collision": "given", "collision_shapes": collisions}
     return {"collision": "auto"}
