@@ -35,7 +35,17 @@ def test_arm_keeps_the_urdf_numbers(tmp_path):
     spec, _doc = load_spec(done.spec_path)
     assert spec.root == "base_footprint"
     joints = {j.name: j for j in spec.joints}
-    assert [j.type for j in spec.joints] == ["fixed", "revolute", "prismatic", "continuous"]
+    assert [j.type for j in spec.joints] == [
+        "fixed",
+        "revolute",
+        "prismatic",
+        "continuous",
+        "continuous",
+    ]
+    follow = spec.joints[-1]
+    assert follow.name == "spin_follow" and not follow.actuated
+    assert (follow.mimic.joint, follow.mimic.multiplier, follow.mimic.offset) == ("spin", -1, 0.1)
+    assert spec.poses["home"][-1] == 0.1  # the follower's home follows its leader's
     turn = joints["turn"]
     assert (turn.lower, turn.upper, turn.effort_peak, turn.max_velocity) == (-2.5, 2.5, 30, 2.0)
     assert (turn.damping, turn.friction, turn.rpy, turn.xyz) == (
@@ -52,6 +62,10 @@ def test_arm_keeps_the_urdf_numbers(tmp_path):
     i = links["bracket"].inertia
     assert math.isclose(i.ixx + i.iyy + i.izz, 0.0075, rel_tol=1e-12) and i.ixz != 0
     assert links["bracket"].solid[0].file == "meshes/bracket.stl"
+    # the URDF's own collision mesh is kept as the link's piece (no CoACD)
+    assert links["bracket"].collision == "given"
+    assert links["bracket"].collision_shapes[0].file == "meshes/bracket.stl"
+    assert links["wheel"].collision == "primitives" and not links["wheel"].collision_primitives
     assert (tmp_path / "meshes" / "bracket.stl").is_file()
     assert [p.shape for p in links["slider"].solid] == ["cylinder", "sphere"]
     # tool0: massless, no geometry, on a fixed joint -> a frame
@@ -74,6 +88,15 @@ def test_gaps_are_estimated_and_reported(tmp_path):
     assert "transmission[turn_trans]: not imported" in text
     assert "arm.urdf:53: limit: estimated: no effort limit" in text
     assert all(f"#   {line}" in done.spec_path.read_text() for line in done.lines)
+
+
+def test_mimic_needs_a_movable_leader(tmp_path):
+    done = import_robot(ARM, tmp_path)
+    text = done.spec_path.read_text().replace("joint: spin,", "joint: base_joint,")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text)
+    with pytest.raises(SpecError, match="mimic needs another movable joint, not 'base_joint'"):
+        load_spec(bad)
 
 
 def test_strict_refuses_gaps(tmp_path):
