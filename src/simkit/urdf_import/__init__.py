@@ -28,6 +28,26 @@ class Imported:
     links: int
 
 
+def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
+    """Raise the floating base so the robot stands on the floor at home; rewrite the spec."""
+    from simkit.urdf_import import standing, writer
+
+    height = standing.standing_height(spec_path)
+    if height is None:
+        return spec_path.read_text(encoding="utf-8")
+    joint = spec["joints"][0]
+    joint["xyz"] = [0.0, 0.0, float(f"{height:.6f}")]
+    joint["estimated"] = ["xyz"]
+    report.changed(
+        doc,
+        doc.root,
+        f"floating base placed {height:.6f} m up: its lowest point at home on the floor",
+    )
+    text = writer.spec_yaml(spec, report.lines, path)
+    spec_path.write_text(text, encoding="utf-8")
+    return text
+
+
 def robot_name(path: Path) -> str:
     """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
     stem = path.name.split(".")[0].lower()
@@ -65,6 +85,8 @@ def import_robot(
             raise SpecError(first.file, first.line, first.field, first.message, first.more)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
+        if floating:
+            text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
         writer.check(stage / f"{name}.yaml")
         for item in sorted(stage.rglob("*")):
             if item.is_file():

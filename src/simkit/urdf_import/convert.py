@@ -155,6 +155,8 @@ def convert(
     }
     if floating:
         spec["floating_base"] = True
+        # a floor to stand on (the legged checks drop the robot onto it)
+        spec["mjcf"] = {"floor": {"name": "floor", "size": [0.0, 0.0, 0.05]}}
     tool = _deepest(spec_root, spec_joints, spec_frames)
     if tool:
         spec["tool_frame"] = tool

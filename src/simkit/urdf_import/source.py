@@ -116,8 +116,8 @@ def find_package(source: Source, package: str) -> Path | None:
 def resolve_uri(source: Source, element, uri: str) -> Path:
     """The file a mesh `filename` names; one-line error if it cannot be found."""
     if uri.startswith("package://"):
-        package, _, rest = uri[len("package://") :].partition("/")
-        base = find_package(source, package)
+        package, _, rest = uri[len("package://") :].lstrip("/").partition("/")
+        base = find_package(source, package) if package else None
         if base is None:
             raise source.fail(element, f"unknown package '{package}' in {uri}")
         path = base / rest
