@@ -80,7 +80,7 @@ def test_gaps_are_estimated_and_reported(tmp_path):
     done = import_robot(ARM, tmp_path)
     spec, _doc = load_spec(done.spec_path)
     slide = next(j for j in spec.joints if j.name == "slide")
-    assert set(slide.estimated) == {"max_velocity", "effort_peak"}
+    assert set(slide.estimated) == {"max_velocity", "effort_peak", "armature"}
     slider = next(link for link in spec.links if link.name == "slider")
     assert slider.inertia_decision is not None and slider.inertia_decision.action == "balance"
     assert "triangle inequality" in slider.inertia_decision.reason

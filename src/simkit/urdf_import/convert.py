@@ -163,6 +163,7 @@ def convert(
     if colours:
         spec["materials"] = [{"name": n, "rgba": list(c)} for c, n in colours.items()]
     spec_joints = _depth_first(spec_joints, spec_root)
+    _check_mimics(source, spec_joints, report)
     rank = {j["child"]: i for i, j in enumerate(spec_joints)}
     spec_links.sort(key=lambda link: rank.get(link["name"], -1))
     movable = [j for j in spec_joints if j["type"] not in ("fixed", "floating")]
@@ -178,6 +179,22 @@ def convert(
     if spec_frames:
         spec["frames"] = spec_frames
     return spec
+
+
+def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
+    """A mimic whose leader is not a movable joint of the spec is reported and dropped."""
+    movable = {j["name"] for j in joints if j["type"] not in ("fixed", "floating")}
+    for joint in joints:
+        mimic = joint.get("mimic")
+        if mimic is not None and (mimic["joint"] not in movable or mimic["joint"] == joint["name"]):
+            del joint["mimic"]
+            joint.pop("actuated", None)
+            element = source.root.find(f"joint[@name='{joint['name']}']/mimic")
+            report.dropped(
+                source,
+                element if element is not None else source.root,
+                f"mimic of '{mimic['joint']}', not a movable joint: imported as independent",
+            )
 
 
 def _depth_first(joints: list[dict], root: str) -> list[dict]:

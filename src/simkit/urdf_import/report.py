@@ -29,6 +29,10 @@ class Report:
         self._line(source, element, "estimated", message)
         self.problems.append(source.fail(element, message))
 
+    def assumed(self, source: Source, element, message: str) -> None:
+        """An estimate of a value no URDF carries (armature): reported, not refused."""
+        self._line(source, element, "estimated", message)
+
     def changed(self, source: Source, element, message: str) -> None:
         """Kept, but in another form (a repaired mesh, a massless link made a frame)."""
         self._line(source, element, "changed", message)
