@@ -14,6 +14,7 @@ via platformdirs).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import io
 import json
@@ -44,8 +45,10 @@ def default_dir() -> Path:
     return Path(user_cache_dir("simkit", appauthor=False))
 
 
+@functools.cache
 def library_version(name: str) -> str:
-    """Installed version of a distribution (part of every key that uses that library)."""
+    """Installed version of a distribution (part of every key that uses that library);
+    looked up once per process (a metadata scan costs ~10 ms, and keys are made per link)."""
     from importlib import metadata
 
     try:
