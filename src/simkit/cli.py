@@ -244,5 +244,55 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
     out.print(f"published {len(index['kits'])} kit(s), {files} files, to {out_dir}", markup=False)
 
 
+@main.command(name="import")
+@click.argument("path", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--name", default=None, help="Spec name [a-z][a-z0-9_]*. [default: from PATH]")
+@click.option(
+    "--package-dir",
+    "package_dirs",
+    multiple=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder holding ROS packages (or a package) for package:// URIs; repeatable.",
+)
+@click.option("--strict", is_flag=True, help="Refuse instead of estimating missing values.")
+@click.option("--floating-base", is_flag=True, help="The root link moves freely (legged).")
+@click.option(
+    "--hull",
+    "hull_collision",
+    is_flag=True,
+    help="Collision meshes: the visual's convex hull (one piece) instead of the URDF's.",
+)
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path))
+@click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
+def import_urdf(
+    path: Path,
+    name: str | None,
+    package_dirs: tuple[Path, ...],
+    strict: bool,
+    floating_base: bool,
+    hull_collision: bool,
+    out_dir: Path,
+    quiet: bool,
+) -> None:
+    """Turn a URDF or xacro into OUT/NAME.yaml plus the meshes it needs."""
+    from simkit.importer import import_robot
+
+    try:
+        done = import_robot(
+            path, out_dir, name, package_dirs, strict, floating_base, hull_collision
+        )
+    except SimkitError as exc:
+        _fail(exc)
+        return
+    if not quiet:
+        for line in done.lines:
+            out.print(line, markup=False)
+    out.print(
+        f"{done.spec_path}: {done.links} links, {done.meshes} meshes, "
+        f"{len(done.lines)} report lines",
+        markup=False,
+    )
+
+
 if __name__ == "__main__":  # pragma: no cover
     main()

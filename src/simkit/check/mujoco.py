@@ -41,11 +41,18 @@ def _dof_indices(model: mujoco.MjModel, names: list[str]) -> list[int]:
 
 
 def random_configs(kit: Kit, count: int, seed: int = 0) -> np.ndarray:
-    """Seeded random joint positions within limits (continuous joints: +-pi)."""
+    """Seeded random joint positions within limits (continuous joints: +-pi); a mimic joint
+    follows its leader (robot.json `mimic`), as URDF readers and the MJCF equality do."""
     rng = np.random.default_rng(seed)
     lower = np.array([j["lower"] if j["lower"] is not None else -np.pi for j in kit.joints])
     upper = np.array([j["upper"] if j["upper"] is not None else np.pi for j in kit.joints])
-    return rng.uniform(lower, upper, size=(count, len(lower)))
+    q = rng.uniform(lower, upper, size=(count, len(lower)))
+    index = {j["name"]: i for i, j in enumerate(kit.joints)}
+    for i, joint in enumerate(kit.joints):
+        mimic = joint.get("mimic")
+        if mimic is not None and mimic["joint"] in index:
+            q[:, i] = mimic["multiplier"] * q[:, index[mimic["joint"]]] + mimic["offset"]
+    return q
 
 
 def check_models(kit: Kit) -> list[Finding]:

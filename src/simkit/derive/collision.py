@@ -10,6 +10,8 @@ Methods (spec `links[].collision`, issue 3 "What to build" 1):
   visual vertex and face centre left outside the hulls is added to the nearest hull.
 - `primitives`: the spec's collision primitives, emitted as primitives by URDF/MJCF/USD.
 - `mesh`: the visual mesh itself (engines collide with its convex hull).
+- `given`: the spec's `collision_shapes` (an imported URDF's own collision geometry), one
+  convex hull each, merged down to `MAX_PIECES`, then grown to cover the visual like `coacd`.
 
 The kit page ("What a kit contains", "Geometry"): collision meshes are convex pieces, up to ten
 per link, link frame, metres.
@@ -338,6 +340,13 @@ def link_collision(link: Link, seed: int) -> tuple[tuple[Mesh, ...], dict]:
         return (), {"method": method, **quality(link.solid, [_manifold(link.solid).hull()])}
     if method == "convex":
         hulls = convex_pieces(link.shapes)
+    elif method == "given":
+        hulls = [_hull(h.vertices) for h in link.given_hulls]
+        hulls = [h for h in hulls if not h.is_empty() and h.volume() > 0]
+        hulls = merge_greedy(hulls) if len(hulls) > MAX_PIECES else hulls
+        hulls = (
+            cover(hulls, surface_samples(link.solid)) if hulls else [_manifold(link.solid).hull()]
+        )
     else:
         hulls = cover(run_coacd(link.solid, seed), surface_samples(link.solid))
     meshes = [_mesh(h) for h in hulls]

@@ -18,8 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.errors import SpecError
 from simkit.kitio.cache import Cache, decode_json, encode_json, make_key
-from simkit.model.robot import Link, Mesh, Robot
+from simkit.model.robot import Link, Mesh, Robot, Shape
 
 Progress = Callable[[str], None]
 
@@ -73,16 +74,41 @@ def derive_solids(robot: Robot, base_dir: Path, cache: Cache) -> Robot:
             solid = link_solid(link.shapes, base_dir)
             cache.put(SOLID_STEP, key, {"vertices": solid.vertices, "faces": solid.faces})
         links.append(replace(link, solid=solid))
+    links = [
+        replace(link, given_hulls=tuple(_shape_hull(s, base_dir) for s in link.collision_shapes))
+        if link.collision_shapes
+        else link
+        for link in links
+    ]
     return replace(robot, links=tuple(links))
+
+
+def _shape_hull(shape: Shape, base_dir: Path) -> Mesh:
+    """The convex hull of one `given` collision shape, placed in the link frame (m). Binary
+    STL files are read without trimesh; any mesh may be open (only its hull is used)."""
+    import manifold3d as mf
+
+    from simkit.kinematics import rpy_matrix
+    from simkit.solids import primitive_solid, to_mesh
+    from simkit.stl import from_stl
+
+    if shape.kind != "mesh":
+        return to_mesh(primitive_solid(shape).hull())
+    path = base_dir / (shape.file or "")
+    if not path.is_file():
+        raise SpecError(str(base_dir), None, "collision_shapes.file", f"not found: {shape.file}")
+    points = from_stl(path.read_bytes()).vertices * shape.scale
+    points = points @ rpy_matrix(shape.rpy).T + np.asarray(shape.xyz)
+    return to_mesh(mf.Manifold.hull_points(np.asarray(points, np.float64)))
 
 
 # --- collision --------------------------------------------------------------------------
 
 
-def _description() -> dict:
+def _description(given: bool = False) -> dict:
     from simkit.derive import collision
 
-    return {
+    out = {
         "methods": {
             "convex": "a union of convex primitives: each primitive's own convex mesh, exact; "
             f"above {collision.MAX_PIECES} pieces, the pair whose merged hull adds the least "
@@ -100,6 +126,12 @@ def _description() -> dict:
         "visual_to_collision_max_m": "largest distance from the visual surface (vertices and "
         "face centres) to the surface of the pieces' union",
     }
+    if given:
+        out["methods"]["given"] = (
+            "the spec's collision_shapes (an imported URDF's collision geometry): one convex hull "
+            "each, merged as `convex` above the limit, then grown like `coacd` to cover the visual"
+        )
+    return out
 
 
 def _collision_key(link: Link, seed: int) -> str:
@@ -108,6 +140,7 @@ def _collision_key(link: Link, seed: int) -> str:
     inputs = (
         [] if link.solid is None else [link.solid.vertices.tobytes(), link.solid.faces.tobytes()]
     )
+    inputs += [h.vertices.tobytes() for h in link.given_hulls]
     return make_key(
         COLLISION_STEP,
         COLLISION_VERSION,
@@ -248,7 +281,7 @@ def derive_collision(
     products = replace(
         robot.products,
         geometry_links=geometry,
-        geometry_collision=_description(),
+        geometry_collision=_description(given=any(link.given_hulls for link in links)),
         seeds=seeds,
     )
     return replace(robot, links=links, products=products)

@@ -203,6 +203,13 @@ def emit(robot: Robot) -> dict[str, bytes]:
     contact = sub(mujoco, "contact")
     for a, b in jointed_pairs(robot):
         sub(contact, "exclude", body1=a, body2=b)
+    mimics = [j for j in robot.joints if j.mimic is not None]
+    if mimics:
+        equality = sub(mujoco, "equality")
+        for joint in mimics:
+            leader, multiplier, offset = joint.mimic  # type: ignore[misc]
+            polycoef = vec((offset, multiplier, 0.0, 0.0, 0.0))
+            sub(equality, "joint", joint1=joint.name, joint2=leader, polycoef=polycoef)
     mjcf_world.sensors(robot, mujoco)
     if mjcf_world.servos_in_main(robot):
         actuators(robot, mujoco)

@@ -61,6 +61,9 @@ def _joint(joint: Joint, extra: dict | None = None) -> dict:
             "peak_torque_formula": "min(motor_peak_torque * gear_ratio * efficiency, "
             "gear_max_output_torque)",
         }
+    if joint.mimic is not None:
+        leader, multiplier, offset = joint.mimic
+        out["mimic"] = {"joint": leader, "multiplier": multiplier, "offset": offset}
     out["actuated"] = joint.actuated
     out["estimated"] = list(joint.estimated)
     return out

@@ -112,6 +112,9 @@ def _joint(root: ET.Element, joint: Joint) -> None:
     limit["velocity"] = num(joint.max_velocity or 0.0)
     sub(el, "limit", limit)
     sub(el, "dynamics", damping=num(joint.damping), friction=num(joint.friction))
+    if joint.mimic is not None:
+        leader, multiplier, offset = joint.mimic
+        sub(el, "mimic", joint=leader, multiplier=num(multiplier), offset=num(offset))
 
 
 def emit(robot: Robot) -> dict[str, bytes]:

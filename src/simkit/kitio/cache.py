@@ -14,6 +14,7 @@ via platformdirs).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import io
 import json
@@ -45,9 +46,21 @@ def default_dir() -> Path:
     return Path(user_cache_dir("simkit", appauthor=False))
 
 
+@functools.cache
+def _installed(name: str) -> str | None:
+    """A distribution's version, None when absent; looked up once per process (a metadata
+    scan costs ~10 ms, and keys are made per link)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return None
+
+
 def library_version(name: str) -> str:
     """Installed version of a distribution (part of every key that uses that library)."""
-    return library_versions((name,))[name] or "none"
+    return _installed(name) or "none"
 
 
 def _canonical(value: object) -> object:
@@ -319,15 +332,7 @@ def decode_plain(arrays: Arrays) -> object:
 
 def library_versions(names: tuple[str, ...]) -> dict[str, str | None]:
     """Installed version of each distribution, None when absent (robot.json provenance)."""
-    from importlib import metadata
-
-    out: dict[str, str | None] = {}
-    for name in names:
-        try:
-            out[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            out[name] = None
-    return out
+    return {name: _installed(name) for name in names}
 
 
 _ARRAY = "__ndarray__"

@@ -146,6 +146,9 @@ def joint_of(spec: JointSpec) -> Joint:
         kp=spec.kp,
         kv=spec.kv,
         mjcf_class=spec.mjcf_class,
+        mimic=(spec.mimic.joint, spec.mimic.multiplier, spec.mimic.offset)
+        if spec.mimic is not None
+        else None,
     )
 
 
@@ -168,6 +171,7 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
                 shapes=tuple(shape_of(p) for p in link.solid),
                 collision_method=link.collision,
                 collision_primitives=tuple(shape_of(p) for p in link.collision_primitives),
+                collision_shapes=tuple(shape_of(p) for p in link.collision_shapes),
                 estimated=tuple(link.estimated),
                 note=link.note,
                 inertia_decision=decision_of(link),

@@ -96,6 +96,10 @@ class Link:
     estimated: tuple[str, ...] = ()
     note: str | None = None
     solid: Mesh | None = None
+    #: `given` collision: shapes whose convex hulls are the pieces (spec collision_shapes)
+    collision_shapes: tuple[Shape, ...] = ()
+    #: their convex hulls in the link frame (filled with the solid)
+    given_hulls: tuple[Mesh, ...] = ()
     collision: tuple[Mesh, ...] = ()
     collision_report: dict | None = None
     inertia_decision: InertiaDecision | None = None
@@ -146,6 +150,8 @@ class Joint:
     kp: float | None = None
     kv: float | None = None
     mjcf_class: str | None = None
+    #: (leader joint, multiplier, offset): value = multiplier * leader + offset
+    mimic: tuple[str, float, float] | None = None
 
     @property
     def movable(self) -> bool:

@@ -129,8 +129,10 @@ class LinkSpec(Strict):
     inertia: InertiaSpec | None = None
     material: str | None = None
     solid: tuple[Primitive, ...] = ()
-    collision: Literal["auto", "convex", "coacd", "primitives", "mesh"] = "auto"
+    collision: Literal["auto", "convex", "coacd", "primitives", "mesh", "given"] = "auto"
     collision_primitives: tuple[CollisionPrimitive, ...] = ()
+    #: `collision: given`: shapes (e.g. an imported URDF's collision meshes), one convex piece each
+    collision_shapes: tuple[Primitive, ...] = ()
     estimated: tuple[str, ...] = ()
     note: str | None = None
     #: keep a non-physical reported inertia on purpose (spec_sim.InertiaDecisionSpec)
@@ -190,6 +192,14 @@ def angle(rad: float | None, deg: float | None) -> float | None:
     return math.radians(deg) if deg is not None else None
 
 
+class MimicSpec(Strict):
+    """URDF `<mimic>`: this joint's value = multiplier * `joint`'s value + offset (rad or m)."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
 class JointSpec(Placed):
     """A joint between two links. `xyz`/`rpy` place the child frame in the parent frame."""
 
@@ -222,6 +232,8 @@ class JointSpec(Placed):
     kp: PositiveFloat | None = None
     kv: NonNegFloat | None = None
     mjcf_class: str | None = None
+    #: coupled to another joint (URDF <mimic>, MJCF <equality><joint>)
+    mimic: MimicSpec | None = None
     estimated: tuple[str, ...] = ()
 
     @model_validator(mode="after")

@@ -74,6 +74,8 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
                 yield ("links", i, "inertia"), why + " (fix it, or record an inertia_decision)"
         if link.inertia is not None and link.com is None:
             yield ("links", i, "com"), "a link that gives its inertia must give its com too"
+        if link.collision == "given" and not link.collision_shapes:
+            yield ("links", i, "collision_shapes"), "'given' collision needs collision_shapes"
         if not link.solid and link.collision != "primitives":
             yield ("links", i, "solid"), "a link needs a solid (its visual geometry)"
         if link.collision == "convex" and any(p.subtract or p.shape == "mesh" for p in link.solid):
@@ -111,6 +113,13 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
                 ("joints", i, "effort_continuous"),
                 f"effort_continuous ({continuous:g}) is greater than effort_peak ({peak:g})",
             )
+        if joint.mimic is not None:
+            leader = next((j for j in spec.joints if j.name == joint.mimic.joint), None)
+            if leader is None or leader.type in ("fixed", "floating") or leader is joint:
+                yield (
+                    ("joints", i, "mimic", "joint"),
+                    f"mimic needs another movable joint, not '{joint.mimic.joint}'",
+                )
         allowed = set(type(joint).model_fields) - {"name", "estimated"}
         for k, field in enumerate(joint.estimated):
             if field not in allowed:

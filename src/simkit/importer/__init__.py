@@ -1,0 +1,98 @@
+"""`simkit import`: a URDF (or xacro) to a spec plus the meshes it needs (issue 15).
+
+The spec keeps the URDF's numbers exactly; gaps are filled with plausible values listed under
+`estimated` and reported one line each (`--strict` refuses them), and every element simkit
+does not keep is reported too. Output: DIR/NAME.yaml and DIR/meshes/*.stl (relative paths),
+written only when the whole import succeeded.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from simkit.errors import SpecError
+from simkit.importer.report import Report
+
+
+@dataclass(frozen=True)
+class Imported:
+    """The written spec, its report lines and the number of meshes written."""
+
+    spec_path: Path
+    lines: tuple[str, ...]
+    meshes: int
+    links: int
+
+
+def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
+    """Raise the floating base so the robot stands on the floor at home; rewrite the spec."""
+    from simkit.importer import standing, writer
+
+    height = standing.standing_height(spec_path)
+    if height is None:
+        return spec_path.read_text(encoding="utf-8")
+    joint = spec["joints"][0]
+    joint["xyz"] = [0.0, 0.0, float(f"{height:.6f}")]
+    joint["estimated"] = ["xyz"]
+    report.changed(
+        doc,
+        doc.root,
+        f"floating base placed {height:.6f} m up: its lowest point at home on the floor",
+    )
+    text = writer.spec_yaml(spec, report.lines, path)
+    spec_path.write_text(text, encoding="utf-8")
+    return text
+
+
+def robot_name(path: Path) -> str:
+    """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
+    stem = path.name.split(".")[0].lower()
+    name = re.sub(r"[^a-z0-9_]+", "_", stem).strip("_") or "robot"
+    return name if name[0].isalpha() else f"robot_{name}"
+
+
+def import_robot(
+    path: Path,
+    out_dir: Path,
+    name: str | None = None,
+    package_dirs: tuple[Path, ...] = (),
+    strict: bool = False,
+    floating: bool = False,
+    hull_collision: bool = False,
+) -> Imported:
+    """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
+    `hull_collision`: links whose URDF collision has meshes collide with their visual
+    solid's convex hull instead (one piece; reported per link)."""
+    from simkit.importer import convert, meshes, source, writer
+
+    name = name or robot_name(path)
+    if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
+        raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
+    doc = source.load(path, package_dirs)
+    report = Report(strict=strict)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
+        stage = Path(tmp)
+        mesh_writer = meshes.MeshWriter(stage)
+        spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
+        if strict and report.problems:
+            first = report.problems[0]
+            first.more = len(report.problems) - 1
+            raise SpecError(first.file, first.line, first.field, first.message, first.more)
+        text = writer.spec_yaml(spec, report.lines, path)
+        (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
+        if floating:
+            text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
+        writer.check(stage / f"{name}.yaml")
+        for item in sorted(stage.rglob("*")):
+            if item.is_file():
+                target = out_dir / item.relative_to(stage)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(item, target)
+    return Imported(
+        out_dir / f"{name}.yaml", tuple(report.lines), len(mesh_writer.done), len(spec["links"])
+    )

@@ -1,0 +1,237 @@
+"""A parsed URDF to a spec dict: the tree, its root, frames, poses and the report."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from simkit.importer.geometry import floats
+from simkit.importer.joints import joint_spec
+from simkit.importer.links import has_geometry, has_mass, link_spec
+from simkit.importer.meshes import MeshWriter
+from simkit.importer.report import Report
+from simkit.importer.source import Source
+
+TOP = {"link", "joint", "material"}
+
+
+def _tree(source: Source) -> tuple[dict, dict, str]:
+    """Links by name, joints by child, and the root link; errors for cycles and orphans."""
+    links: dict = {}
+    for link in source.root.findall("link"):
+        name = link.get("name")
+        if not name:
+            raise source.fail(link, "a link needs a name")
+        if name in links:
+            raise source.fail(link, f"link '{name}' is defined twice")
+        links[name] = link
+    if not links:
+        raise source.fail(source.root, "no <link> in the robot")
+    by_child: dict = {}
+    for joint in source.root.findall("joint"):
+        for end in ("parent", "child"):
+            tag = joint.find(end)
+            if tag is not None and tag.get("link") not in links:
+                raise source.fail(joint, f"unknown {end} link '{tag.get('link')}'")
+        child = joint.find("child")
+        if child is None:
+            raise source.fail(joint, "a joint needs <child link=...>")
+        if child.get("link") in by_child:
+            raise source.fail(joint, f"link '{child.get('link')}' already has a parent joint")
+        by_child[child.get("link")] = joint
+    roots = [name for name in links if name not in by_child]
+    if not roots:
+        raise source.fail(next(iter(by_child.values())), "the joints form a cycle (no root link)")
+    if len(roots) > 1:
+        raise source.fail(links[roots[1]], f"links {roots[:3]} have no parent: more than one root")
+    for name in links:  # every link must reach the root
+        seen, at = set(), name
+        while at in by_child:
+            if at in seen:
+                raise source.fail(by_child[at], "the joints form a cycle")
+            seen.add(at)
+            at = by_child[at].find("parent").get("link")
+    return links, by_child, roots[0]
+
+
+def _children(by_child: dict) -> dict[str, list[str]]:
+    out: dict[str, list[str]] = {}
+    for child, joint in by_child.items():
+        out.setdefault(joint.find("parent").get("link"), []).append(child)
+    return out
+
+
+def _load(source, name, links, kids, by_child) -> tuple[float, float]:
+    """Mass (kg) of a link's subtree and a lever arm (m): the longest chain of joint offsets."""
+    mass = 0.0
+    element = links[name].find("inertial/mass")
+    if has_mass(links[name]):
+        mass = floats(source, element, "value", 1)
+    arm = 0.0
+    for child in kids.get(name, []):
+        sub_mass, sub_arm = _load(source, child, links, kids, by_child)
+        xyz = by_child[child].find("origin")
+        offset = (
+            0.0 if xyz is None else float(np.linalg.norm(floats(source, xyz, "xyz", 3, "0 0 0")))
+        )
+        mass += sub_mass
+        arm = max(arm, offset + sub_arm)
+    return mass, max(arm, 0.1)
+
+
+def _frame_links(links, by_child, kids, root) -> set[str]:
+    """Massless, geometry-free leaves on fixed joints: they become frames."""
+    return {
+        name
+        for name, link in links.items()
+        if name != root
+        and not kids.get(name)
+        and by_child[name].get("type") == "fixed"
+        and not has_mass(link)
+        and not has_geometry(link)
+    }
+
+
+def materials_of(source: Source) -> dict[str, tuple]:
+    out = {}
+    for material in source.root.iter("material"):
+        colour = material.find("color")
+        if material.get("name") and colour is not None:
+            out.setdefault(material.get("name"), floats(source, colour, "rgba", 4))
+    return out
+
+
+def convert(
+    source: Source,
+    name: str,
+    writer: MeshWriter,
+    report: Report,
+    floating: bool,
+    hull_collision: bool = False,
+) -> dict:
+    """The spec dict for the whole robot."""
+    for element in source.root:
+        if isinstance(element.tag, str) and element.tag not in TOP:
+            report.dropped(
+                source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
+            )
+    links, by_child, root = _tree(source)
+    kids = _children(by_child)
+    frames = _frame_links(links, by_child, kids, root)
+    materials, colours = materials_of(source), {}
+    root_is_frame = not has_mass(links[root]) and not has_geometry(links[root]) and not floating
+    spec_links, spec_joints, spec_frames = [], [], []
+    spec_root = root if root_is_frame else "world"
+    if not root_is_frame:
+        joint_type = "floating" if floating else "fixed"
+        spec_joints.append(
+            {"name": f"{root}_{joint_type}", "type": joint_type, "parent": "world", "child": root}
+        )
+    for link_name in links:  # document order
+        if link_name == spec_root:
+            continue
+        if link_name in frames:
+            joint = by_child[link_name]
+            js = joint_spec(source, joint, report, (0.0, 0.1))
+            frame = {"name": link_name, "parent": js["parent"]}
+            frame.update({k: js[k] for k in ("xyz", "rpy") if k in js})
+            spec_frames.append(frame)
+            continue
+        spec_links.append(
+            link_spec(source, links[link_name], writer, report, materials, colours, hull_collision)
+        )
+        if link_name in by_child:
+            load = _load(source, link_name, links, kids, by_child)
+            spec_joints.append(joint_spec(source, by_child[link_name], report, load))
+    if floating and has_mass(links[root]) is False and not has_geometry(links[root]):
+        report.changed(source, links[root], "massless root of a floating base")
+    spec: dict = {
+        "name": name,
+        "title": source.root.get("name") or name,
+        "description": f"Imported from {source.path.name} by simkit import.",
+        "sources": [source.path.name],
+        "root": spec_root,
+    }
+    if floating:
+        spec["floating_base"] = True
+        # a floor to stand on (the legged checks drop the robot onto it)
+        spec["mjcf"] = {"floor": {"name": "floor", "size": [0.0, 0.0, 0.05]}}
+    tool = _deepest(spec_root, spec_joints, spec_frames)
+    if tool:
+        spec["tool_frame"] = tool
+    if colours:
+        spec["materials"] = [{"name": n, "rgba": list(c)} for c, n in colours.items()]
+    spec_joints = _depth_first(spec_joints, spec_root)
+    _check_mimics(source, spec_joints, report)
+    rank = {j["child"]: i for i, j in enumerate(spec_joints)}
+    spec_links.sort(key=lambda link: rank.get(link["name"], -1))
+    movable = [j for j in spec_joints if j["type"] not in ("fixed", "floating")]
+    if movable:
+        home = {j["name"]: _home(j) for j in movable}
+        for j in movable:  # a mimic joint follows its leader
+            if "mimic" in j and j["mimic"]["joint"] in home:
+                m = j["mimic"]
+                home[j["name"]] = m["multiplier"] * home[m["joint"]] + m["offset"]
+        spec["poses"] = {"home": [home[j["name"]] for j in movable]}
+    spec["links"] = spec_links
+    spec["joints"] = spec_joints
+    if spec_frames:
+        spec["frames"] = spec_frames
+    return spec
+
+
+def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
+    """A mimic whose leader is not a movable joint of the spec is reported and dropped."""
+    movable = {j["name"] for j in joints if j["type"] not in ("fixed", "floating")}
+    for joint in joints:
+        mimic = joint.get("mimic")
+        if mimic is not None and (mimic["joint"] not in movable or mimic["joint"] == joint["name"]):
+            del joint["mimic"]
+            joint.pop("actuated", None)
+            element = source.root.find(f"joint[@name='{joint['name']}']/mimic")
+            report.dropped(
+                source,
+                element if element is not None else source.root,
+                f"mimic of '{mimic['joint']}', not a movable joint: imported as independent",
+            )
+
+
+def _depth_first(joints: list[dict], root: str) -> list[dict]:
+    """Joints depth first from the root, siblings in document order (the spec's tree order,
+    which `poses` follow)."""
+    by_parent: dict[str, list[dict]] = {}
+    for joint in joints:
+        by_parent.setdefault(joint["parent"], []).append(joint)
+    out: list[dict] = []
+    stack = list(reversed(by_parent.get(root, [])))
+    while stack:
+        joint = stack.pop()
+        out.append(joint)
+        stack.extend(reversed(by_parent.get(joint["child"], [])))
+    return out
+
+
+def _home(joint: dict) -> float:
+    """0 when inside the limits, else the middle of the range."""
+    lower, upper = joint.get("lower", -math.inf), joint.get("upper", math.inf)
+    return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
+
+
+def _deepest(root: str, joints: list[dict], frames: list[dict]) -> str | None:
+    """The link or frame with the most joints above it (first in document order)."""
+    depth = {root: 0}
+    pending = list(joints)
+    while pending:
+        rest = [j for j in pending if j["parent"] not in depth]
+        for joint in pending:
+            if joint["parent"] in depth:
+                depth[joint["child"]] = depth[joint["parent"]] + 1
+        if len(rest) == len(pending):
+            break
+        pending = rest
+    for frame in frames:
+        if frame["parent"] in depth:
+            depth[frame["name"]] = depth[frame["parent"]] + 1
+    best = max(depth.items(), key=lambda item: item[1], default=(None, 0))
+    return best[0] if best[1] > 0 else None

@@ -1,0 +1,133 @@
+"""URDF `<joint>` to a spec joint: type, origin, axis, limits, dynamics, mimic."""
+
+from __future__ import annotations
+
+import math
+
+from simkit.importer.geometry import floats, origin, placed
+from simkit.importer.report import Report
+from simkit.importer.source import Source
+
+TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating"}
+KNOWN = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
+#: rad/s and m/s given to a joint without a velocity limit
+VELOCITY = {"revolute": 3.0, "continuous": 3.0, "prismatic": 0.5}
+G = 9.81
+#: kg m^2 per N m of effort (kg per N for prismatic): the estimated armature (reflected rotor
+#: inertia). With simkit's servo (kp = effort per 0.01 rad) it bounds the servo's frequency
+#: to sqrt(100 / 1e-3) = 316 rad/s, 0.63 rad per 2 ms step: stable however light the link.
+ARMATURE_PER_EFFORT = 1.0e-3
+
+
+def joint_spec(source: Source, joint, report: Report, load: tuple[float, float]) -> dict:
+    """The spec dict of one joint. `load` = (mass, lever arm in m) of what it carries, for an
+    effort the URDF does not give."""
+    kind = joint.get("type", "")
+    name = joint.get("name")
+    if kind == "planar":
+        raise source.fail(joint, "planar joints are not supported")
+    if kind not in TYPES:
+        raise source.fail(joint, f"unknown joint type '{kind}'")
+    parent, child = joint.find("parent"), joint.find("child")
+    if parent is None or child is None or not parent.get("link") or not child.get("link"):
+        raise source.fail(joint, "a joint needs <parent link=...> and <child link=...>")
+    for element in joint:
+        if isinstance(element.tag, str) and element.tag not in KNOWN:
+            report.dropped(source, element, "not a URDF joint element simkit keeps")
+    xyz, rpy = origin(source, joint)
+    spec: dict = {
+        "name": name,
+        "type": kind,
+        "parent": parent.get("link"),
+        "child": child.get("link"),
+        **placed(xyz, rpy),
+    }
+    if kind in ("fixed", "floating"):
+        return spec
+    axis_el = joint.find("axis")
+    axis = (1.0, 0.0, 0.0) if axis_el is None else floats(source, axis_el, "xyz", 3, "1 0 0")
+    if math.sqrt(sum(a * a for a in axis)) < 1e-9:
+        raise source.fail(axis_el, "joint axis must not be zero")
+    spec["axis"] = list(axis)
+    estimated: list[str] = []
+    spec.update(_limits(source, joint, kind, report, load, estimated))
+    dynamics = joint.find("dynamics")
+    if dynamics is not None:
+        for key in ("damping", "friction"):
+            value = floats(source, dynamics, key, 1, "0")
+            if value < 0:
+                raise source.fail(dynamics, f"{key} must be >= 0, got {value}")
+            if value:
+                spec[key] = value
+    mimic = joint.find("mimic")
+    if mimic is not None:
+        if not mimic.get("joint"):
+            raise source.fail(mimic, "mimic needs a 'joint'")
+        spec["mimic"] = {
+            "joint": mimic.get("joint"),
+            "multiplier": floats(source, mimic, "multiplier", 1, "1"),
+            "offset": floats(source, mimic, "offset", 1, "0"),
+        }
+        spec["actuated"] = False  # it follows its leader (MJCF equality), no servo of its own
+    if estimated:
+        spec["estimated"] = estimated
+    return spec
+
+
+def _limits(
+    source: Source, joint, kind: str, report: Report, load: tuple[float, float], estimated: list
+) -> dict:
+    limit = joint.find("limit")
+    out: dict = {}
+    element = limit if limit is not None else joint
+    if kind != "continuous":
+        lower = None if limit is None else limit.get("lower")
+        upper = None if limit is None else limit.get("upper")
+        same = lower is not None and upper is not None and _num(lower) == _num(upper)
+        if (lower is None and upper is None) or same:
+            span = math.pi if kind == "revolute" else 0.1
+            unit = "rad" if kind == "revolute" else "m"
+            why = "lower == upper (no range)" if same else "no position limits"
+            report.estimated(source, element, f"{why}: +-{span:g} {unit}")
+            out["lower"], out["upper"] = -span, span
+            estimated += ["lower", "upper"]
+        else:
+            out["lower"] = floats(source, limit, "lower", 1, "0")
+            out["upper"] = floats(source, limit, "upper", 1, "0")
+            if out["lower"] > out["upper"]:
+                raise source.fail(limit, f"lower ({out['lower']}) is greater than upper")
+    velocity = 0.0 if limit is None else abs(floats(source, limit, "velocity", 1, "0"))
+    if velocity <= 0:
+        velocity = VELOCITY[kind]
+        report.estimated(source, element, f"no velocity limit: {velocity:g}")
+        estimated.append("max_velocity")
+    out["max_velocity"] = velocity
+    effort = 0.0 if limit is None else abs(floats(source, limit, "effort", 1, "0"))
+    if effort <= 0:
+        mass, arm = load
+        effort = float(f"{max(1.0, 2.0 * mass * G * (1.0 if kind == 'prismatic' else arm)):.3g}")
+        report.estimated(
+            source,
+            element,
+            f"no effort limit: {effort:g}, twice the static load of what it carries",
+        )
+        estimated.append("effort_peak")
+    out["effort_peak"] = effort
+    if joint.find("mimic") is None:
+        armature = float(f"{ARMATURE_PER_EFFORT * effort:.3g}")
+        report.assumed(
+            source,
+            element,
+            f"no armature in a URDF: {armature:g} ({ARMATURE_PER_EFFORT:g} x effort, a geared "
+            "motor's reflected rotor inertia; keeps the servo stable on light links)",
+        )
+        out["armature"] = armature
+        estimated.append("armature")
+    return out
+
+
+def _num(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None

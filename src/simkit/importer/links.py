@@ -1,0 +1,175 @@
+"""URDF `<link>` to a spec link: inertial, geometry, colour and collision choice."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from simkit.importer.geometry import floats, origin, shape_of
+from simkit.importer.meshes import MeshWriter
+from simkit.importer.report import Report
+from simkit.importer.source import Source
+
+#: kg and kg m^2 given to a link the URDF leaves massless (MuJoCo needs mass on moving bodies)
+MASSLESS_MASS, MASSLESS_INERTIA = 0.001, 1.0e-7
+#: kg/m^3 of the solid sphere whose inertia replaces a zero one
+DENSITY = 1000.0
+KNOWN = {"inertial", "visual", "collision"}
+
+
+def has_mass(link) -> bool:
+    """True when the link's `<inertial>` gives a positive mass."""
+    mass = link.find("inertial/mass")
+    try:
+        return mass is not None and float(mass.get("value", "0")) > 0
+    except ValueError:
+        return False
+
+
+def has_geometry(link) -> bool:
+    return link.find("visual") is not None or link.find("collision") is not None
+
+
+def _rotated(tensor: np.ndarray, rpy) -> np.ndarray:
+    from simkit.model.kinematics import rpy_matrix
+
+    rot = rpy_matrix(rpy)
+    return rot @ tensor @ rot.T
+
+
+def inertial(source: Source, link, report: Report) -> dict:
+    """mass, com, inertia (about the CoM, link axes) and the estimates and decision made."""
+    from simkit.spec.schema import InertiaSpec
+    from simkit.spec.validate import inertia_problem
+
+    element = link.find("inertial")
+    if not has_mass(link):
+        report.estimated(
+            source,
+            link,
+            f"no positive mass in the URDF: {MASSLESS_MASS} kg, inertia {MASSLESS_INERTIA} kg m^2",
+        )
+        i = MASSLESS_INERTIA
+        return {
+            "mass": MASSLESS_MASS,
+            "com": [0.0, 0.0, 0.0],
+            "inertia": {"ixx": i, "iyy": i, "izz": i},
+            "estimated": ["mass", "com", "inertia"],
+            "note": "massless in the URDF; a small mass keeps MuJoCo's moving bodies valid",
+        }
+    mass = floats(source, element.find("mass"), "value", 1)
+    xyz, rpy = origin(source, element)
+    tag = element.find("inertia")
+    if tag is None:
+        values = (0.0,) * 6
+    else:
+        values = tuple(
+            floats(source, tag, k, 1, "0") for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        )
+    ixx, iyy, izz, ixy, ixz, iyz = values
+    tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    if any(rpy):
+        tensor = _rotated(tensor, rpy)
+    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
+    out: dict = {"mass": mass, "com": list(xyz)}
+    if np.trace(tensor) <= 1e-12 * max(mass, 1e-12):
+        radius = (3 * mass / (4 * math.pi * DENSITY)) ** (1 / 3)
+        moment = 0.4 * mass * radius * radius
+        report.estimated(
+            source,
+            tag if tag is not None else element,
+            f"zero inertia: a {DENSITY:g} kg/m^3 solid sphere of that mass ({moment:.3g} kg m^2)",
+        )
+        out["inertia"] = {"ixx": moment, "iyy": moment, "izz": moment}
+        out["estimated"] = ["inertia"]
+        return out
+    out["inertia"] = {k: float(round(v, 15)) for k, v in zip(keys, flat, strict=True)}
+    problem = inertia_problem(InertiaSpec(**out["inertia"]))
+    if problem:
+        report.estimated(source, tag, f"{problem}: balanced (inertia_decision)")
+        out["inertia_decision"] = {
+            "action": "balance",
+            "reason": f"the URDF's inertia is not physical ({problem}); imported as given, "
+            "the kit carries the balanced tensor",
+        }
+    return out
+
+
+def _colour(source: Source, visual, materials: dict[str, tuple]) -> tuple | None:
+    element = visual.find("material")
+    if element is None:
+        return None
+    colour = element.find("color")
+    if colour is not None:
+        return floats(source, colour, "rgba", 4)
+    return materials.get(element.get("name", ""))
+
+
+def link_spec(
+    source: Source,
+    link,
+    writer: MeshWriter,
+    report: Report,
+    materials: dict[str, tuple],
+    colours: dict[tuple, str],
+    hull_collision: bool = False,
+) -> dict:
+    """The spec dict of one link. `colours` maps rgba -> material name (filled here)."""
+    name = link.get("name")
+    spec: dict = {"name": name, **inertial(source, link, report)}
+    for child in link:
+        if isinstance(child.tag, str) and child.tag not in KNOWN:
+            report.dropped(source, child, "not a URDF link element simkit keeps")
+    visuals, rgba = [], None
+    for visual in link.findall("visual"):
+        got = shape_of(source, visual, writer, report, "visual")
+        if got is None:
+            continue
+        shape, info = got
+        visuals.append(shape)
+        if info is not None and info.repair == "hull":
+            report.changed(source, visual, f"{shape['file']}: open mesh, its convex hull is used")
+        colour = _colour(source, visual, materials) or (info.rgba if info else None)
+        if rgba is None and colour is not None:
+            rgba = tuple(float(c) for c in colour)
+    collisions, infos = [], []
+    for element in link.findall("collision"):
+        got = shape_of(source, element, writer, report, "collision")
+        if got is not None:
+            collisions.append(got[0])
+            infos.append(got[1])
+    solid = visuals
+    if not visuals and collisions:
+        solid = collisions
+        report.changed(source, link, "no visual: the collision geometry is the visual solid")
+    used = {s["file"] for s in solid if s["shape"] == "mesh"}
+    if any(i.file in used and i.repair == "hull" for i in writer.done.values()):
+        spec["estimated"] = [*spec.get("estimated", []), "solid"]
+    if solid:
+        spec["solid"] = solid
+    if rgba is not None:
+        colours.setdefault(rgba, f"colour_{len(colours)}")
+        spec["material"] = colours[rgba]
+    chosen = _collision(collisions, infos)
+    if hull_collision and chosen["collision"] in ("given", "auto"):
+        chosen = {"collision": "mesh"}
+        report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
+    spec.update(chosen)
+    return spec
+
+
+#: up to this many collision elements are kept as the link's pieces (one convex hull each)
+MAX_GIVEN = 10
+PRIMITIVES = {"box", "cylinder", "sphere", "capsule"}
+
+
+def _collision(collisions: list[dict], infos: list) -> dict:
+    """Primitives stay primitives; up to MAX_GIVEN meshes are kept, one convex piece each
+    (`given`); more go to the cached CoACD path (`auto`); none means no collision geometry."""
+    if all(c["shape"] in PRIMITIVES for c in collisions):
+        return {"collision": "primitives", "collision_primitives": collisions}
+    if len(collisions) <= MAX_GIVEN:
+        return {"collision": "given", "collision_shapes": collisions}
+    return {"collision": "auto"}

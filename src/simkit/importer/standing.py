@@ -1,0 +1,58 @@
+"""Where a floating-base robot stands: the height of its base above the floor at `home`.
+
+A URDF says nothing about it (the free joint is implicit), but simkit's floating joint has an
+origin that the legged checks drop the robot from. The importer puts the base so that the
+lowest point of any visual solid at the home pose touches the floor (z = 0); it is recorded
+as an estimate.
+"""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+
+
+def _points(shape, base_dir: Path) -> np.ndarray:
+    """Points bounding one primitive in its link frame (m): mesh vertices, box corners, or the
+    corners of a round shape's bounding box."""
+    from simkit.kitio.stl import from_stl
+    from simkit.model.kinematics import rpy_matrix
+
+    if shape.kind == "mesh":
+        local = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
+    else:
+        if shape.kind == "box":
+            half = np.asarray(shape.size) / 2
+        elif shape.kind == "sphere":
+            half = np.full(3, shape.radius)
+        else:  # cylinder, capsule, cone: along local z
+            extra = shape.radius if shape.kind == "capsule" else 0.0
+            half = np.array([shape.radius, shape.radius, shape.length / 2 + extra])
+        local = np.array(list(itertools.product(*[(-h, h) for h in half])))
+    return local @ rpy_matrix(shape.rpy).T + np.asarray(shape.xyz)
+
+
+def standing_height(spec_path: Path) -> float | None:
+    """Height (m) of the floating base's origin that puts the robot's lowest point at home on
+    the floor; None when no link has a solid."""
+    import yaml
+
+    from simkit.model.kinematics import forward
+    from simkit.model.resolve import resolve
+    from simkit.spec.schema import RobotSpec
+
+    text = spec_path.read_text(encoding="utf-8")
+    spec = RobotSpec.model_validate(yaml.safe_load(text))
+    robot = resolve(spec, text.encode(), spec_path.name)
+    home = dict(robot.poses).get("home")
+    poses = forward(robot, home)
+    lowest = None
+    for link in robot.links:
+        for shape in link.shapes:
+            pts = _points(shape, spec_path.parent)
+            world = pts @ poses[link.name][:3, :3].T + poses[link.name][:3, 3]
+            z = float(world[:, 2].min())
+            lowest = z if lowest is None else min(lowest, z)
+    return None if lowest is None else -lowest

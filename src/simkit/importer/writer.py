@@ -1,0 +1,44 @@
+"""The spec as YAML: the report as a comment header, then the spec, deterministic."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+
+class _Dumper(yaml.SafeDumper):
+    """Flow style for short number lists (xyz, rgba), block style for the rest."""
+
+
+def _list(dumper: yaml.SafeDumper, data: list) -> yaml.Node:
+    flow = all(isinstance(v, (int, float)) for v in data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
+
+
+def _dict(dumper: yaml.SafeDumper, data: dict) -> yaml.Node:
+    flow = all(isinstance(v, (int, float, str)) for v in data.values()) and len(data) <= 6
+    return dumper.represent_mapping("tag:yaml.org,2002:map", data.items(), flow_style=flow)
+
+
+_Dumper.add_representer(list, _list)
+_Dumper.add_representer(tuple, _list)
+_Dumper.add_representer(dict, _dict)
+
+
+def spec_yaml(spec: dict, lines: list[str], source: Path) -> str:
+    """The spec text: a header naming the source and each report line, then the spec."""
+    head = [
+        f"# Imported from {source.name} by `simkit import`. Numbers are the URDF's; values it",
+        "# lacks are filled, listed under `estimated` and reported here:",
+    ]
+    head += [f"#   {line}" for line in lines] or ["#   (nothing estimated or left out)"]
+    body = yaml.dump(spec, Dumper=_Dumper, sort_keys=False, width=100, allow_unicode=False)
+    return "\n".join(head) + "\n" + body
+
+
+def check(path: Path) -> None:
+    """Load the written spec through simkit's own validation (SpecError on a problem)."""
+    from simkit.spec.validate import load_spec
+
+    load_spec(path, display=str(path))

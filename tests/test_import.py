@@ -1,0 +1,184 @@
+"""`simkit import` (issue 15): URDF/xacro to a spec, gaps reported, errors on one line."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import pytest
+import yaml
+from click.testing import CliRunner
+
+from simkit.cli import main
+from simkit.errors import SpecError
+from simkit.importer import import_robot
+from simkit.spec.validate import load_spec
+
+URDF = Path(__file__).resolve().parent / "specs" / "urdf"
+ARM = URDF / "pkg_demo" / "urdf" / "arm.urdf"
+
+
+def _corpus() -> Path | None:
+    """example-robot-data's robots folder (the test extra installs it), or None."""
+    import site
+
+    for base in site.getsitepackages():
+        path = Path(base) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+        if path.is_dir():
+            return path
+    return None
+
+
+def test_arm_keeps_the_urdf_numbers(tmp_path):
+    done = import_robot(ARM, tmp_path)
+    spec, _doc = load_spec(done.spec_path)
+    assert spec.root == "base_footprint"
+    joints = {j.name: j for j in spec.joints}
+    assert [j.type for j in spec.joints] == [
+        "fixed",
+        "revolute",
+        "prismatic",
+        "continuous",
+        "continuous",
+    ]
+    follow = spec.joints[-1]
+    assert follow.name == "spin_follow" and not follow.actuated
+    assert (follow.mimic.joint, follow.mimic.multiplier, follow.mimic.offset) == ("spin", -1, 0.1)
+    assert spec.poses["home"][-1] == 0.1  # the follower's home follows its leader's
+    turn = joints["turn"]
+    assert (turn.lower, turn.upper, turn.effort_peak, turn.max_velocity) == (-2.5, 2.5, 30, 2.0)
+    assert (turn.damping, turn.friction, turn.rpy, turn.xyz) == (
+        0.5,
+        0.1,
+        (0, 0, 0.1),
+        (0, 0, 0.02),
+    )
+    assert joints["spin"].axis == (0, 1, 0) and joints["slide"].axis == (1, 0, 0)
+    links = {link.name: link for link in spec.links}
+    assert links["base_link"].mass == 2.0 and links["base_link"].com == (0, 0, 0.02)
+    assert links["base_link"].collision == "primitives"
+    # the bracket's inertial is rotated by its origin rpy into link axes: trace is kept
+    i = links["bracket"].inertia
+    assert math.isclose(i.ixx + i.iyy + i.izz, 0.0075, rel_tol=1e-12) and i.ixz != 0
+    assert links["bracket"].solid[0].file == "meshes/bracket.stl"
+    # the URDF's own collision mesh is kept as the link's piece (no CoACD)
+    assert links["bracket"].collision == "given"
+    assert links["bracket"].collision_shapes[0].file == "meshes/bracket.stl"
+    assert links["wheel"].collision == "primitives" and not links["wheel"].collision_primitives
+    assert (tmp_path / "meshes" / "bracket.stl").is_file()
+    assert [p.shape for p in links["slider"].solid] == ["cylinder", "sphere"]
+    # tool0: massless, no geometry, on a fixed joint -> a frame
+    assert [(f.name, f.parent) for f in spec.frames] == [("tool0", "wheel")]
+    assert spec.tool_frame == "tool0"
+    colours = {m.name: m.rgba for m in spec.materials}
+    assert colours[links["base_link"].material] == (0.1, 0.2, 0.8, 1.0)
+    assert colours[links["bracket"].material] == (0.8, 0.1, 0.1, 1.0)
+
+
+def test_gaps_are_estimated_and_reported(tmp_path):
+    done = import_robot(ARM, tmp_path)
+    spec, _doc = load_spec(done.spec_path)
+    slide = next(j for j in spec.joints if j.name == "slide")
+    assert set(slide.estimated) == {"max_velocity", "effort_peak", "armature"}
+    slider = next(link for link in spec.links if link.name == "slider")
+    assert slider.inertia_decision is not None and slider.inertia_decision.action == "balance"
+    assert "triangle inequality" in slider.inertia_decision.reason
+    text = "\n".join(done.lines)
+    assert "transmission[turn_trans]: not imported" in text
+    assert "arm.urdf:53: limit: estimated: no effort limit" in text
+    assert all(f"#   {line}" in done.spec_path.read_text() for line in done.lines)
+
+
+def test_mimic_needs_a_movable_leader(tmp_path):
+    done = import_robot(ARM, tmp_path)
+    text = done.spec_path.read_text().replace("joint: spin,", "joint: base_joint,")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text)
+    with pytest.raises(SpecError, match="mimic needs another movable joint, not 'base_joint'"):
+        load_spec(bad)
+
+
+def test_strict_refuses_gaps(tmp_path):
+    with pytest.raises(SpecError) as err:
+        import_robot(ARM, tmp_path / "out", strict=True)
+    assert "arm.urdf:58: inertia: " in str(err.value) and "(and 2 more errors)" in str(err.value)
+    assert not (tmp_path / "out" / "arm.yaml").exists()
+
+
+def test_import_is_deterministic(tmp_path):
+    a, b = import_robot(ARM, tmp_path / "a"), import_robot(ARM, tmp_path / "b")
+    assert a.spec_path.read_bytes() == b.spec_path.read_bytes()
+    assert (tmp_path / "a/meshes/bracket.stl").read_bytes() == (
+        tmp_path / "b/meshes/bracket.stl"
+    ).read_bytes()
+
+
+def test_package_dir_and_ros_package_path(tmp_path, monkeypatch):
+    copy = tmp_path / "elsewhere" / "arm.urdf"
+    copy.parent.mkdir()
+    shutil.copy(ARM, copy)  # no package.xml above the copy: the walk-up finds nothing
+    with pytest.raises(SpecError, match="unknown package 'pkg_demo'"):
+        import_robot(copy, tmp_path / "none")
+    import_robot(copy, tmp_path / "dir", package_dirs=(URDF,))
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(URDF))
+    assert import_robot(copy, tmp_path / "env").meshes == 1
+
+
+def test_xacro_is_expanded(tmp_path):
+    done = import_robot(URDF / "arm.urdf.xacro", tmp_path, name="xacro_arm")
+    spec, _doc = load_spec(done.spec_path)
+    assert spec.root == "world" and [link.name for link in spec.links] == ["rod1", "rod2"]
+    assert spec.joints[1].xyz == (0, 0, 0.3)
+    assert spec.links[0].solid[0].size == (0.04, 0.04, 0.3)
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("malformed.urdf", "malformed.urdf:4: xml: malformed XML: Opening and ending tag mismatch"),
+        ("cycle.urdf", "cycle.urdf:5: joint[ab]: the joints form a cycle"),
+        ("missing_mesh.urdf", "missing_mesh.urdf:5: mesh: mesh file not found: meshes/nowhere"),
+        ("unknown_package.urdf", "unknown_package.urdf:5: mesh: unknown package 'no_such_package'"),
+    ],
+)
+def test_errors_are_one_line(tmp_path, name, message):
+    result = CliRunner().invoke(main, ["import", str(URDF / name), "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    assert message in result.output and "Traceback" not in result.output
+    assert len(result.output.strip().splitlines()) == 1
+    assert not list(tmp_path.glob("*.yaml"))
+
+
+def test_cli_writes_spec(tmp_path):
+    result = CliRunner().invoke(
+        main, ["import", str(ARM), "--name", "demo", "--out", str(tmp_path), "-q"]
+    )
+    assert result.exit_code == 0, result.output
+    assert yaml.safe_load((tmp_path / "demo.yaml").read_text())["name"] == "demo"
+
+
+def test_corpus_floating_base_and_dae(tmp_path):
+    """Solo 12 (package:// URIs, a floating base) and UR5 (DAE visuals, a mesh-less ee_link)."""
+    corpus = _corpus()
+    if corpus is None:
+        pytest.skip("example-robot-data is not installed (test extra)")
+    solo = import_robot(
+        corpus / "solo_description/robots/solo12.urdf", tmp_path / "solo", floating=True
+    )
+    spec, _doc = load_spec(solo.spec_path)
+    assert spec.floating_base and spec.joints[0].type == "floating"
+    assert sum(j.type == "revolute" for j in spec.joints) == 12
+    ur5 = import_robot(corpus / "ur_description/urdf/ur5_robot.urdf", tmp_path / "ur5")
+    spec, _doc = load_spec(ur5.spec_path)
+    assert len(spec.links) == 8 and any(
+        p.file.endswith(".stl") for link in spec.links for p in link.solid if p.shape == "mesh"
+    )
+    assert (tmp_path / "ur5" / "meshes" / "base.stl").is_file()
+
+
+@pytest.mark.slow
+def test_imported_arm_builds(tmp_path, kit_factory):
+    done = import_robot(ARM, tmp_path)
+    result = kit_factory(str(done.spec_path))
+    assert result.kit_dir.is_dir()
