@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
-from simkit import spec_mjcf, spec_sim
+from simkit import spec_bounds, spec_mjcf, spec_names, spec_sim
 from simkit.errors import SpecError
 from simkit.spec import InertiaSpec, RobotSpec
 from simkit.yamlsource import Loc, SourceDoc, dotted, load_yaml
@@ -50,6 +50,8 @@ def _fmt3(values: np.ndarray) -> str:
 
 
 def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
+    yield from spec_names.problems(spec)
+    yield from spec_bounds.problems(spec)
     links = {link.name: i for i, link in enumerate(spec.links)}
     materials = {m.name for m in spec.materials}
     names_seen: dict[str, Loc] = {spec.root: ("root",)}
