@@ -10,6 +10,7 @@ from pathlib import Path
 
 from simkit.check.findings import Finding, require
 from simkit.check.freefall_check import check_freefall
+from simkit.check.generated_check import check_generated
 from simkit.check.geometry_check import check_collision, check_glb
 from simkit.check.kit import Kit
 from simkit.check.legged_check import check_legged
@@ -35,6 +36,7 @@ CHECKS: dict[str, Check] = {
     "usd": check_usd,
     "motion": check_motion,
     "freefall": check_freefall,
+    "generated": check_generated,
 }
 
 
