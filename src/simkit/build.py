@@ -8,12 +8,11 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from simkit import layout
+from simkit import atomic, layout
 from simkit.archive import zip_bytes
 from simkit.cache import Cache
 from simkit.check import run_checks_cached
@@ -152,27 +151,27 @@ def build(
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
     files = _emit_cached(robot, usd_format, cache)
-    out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
-    staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))
-    try:
-        staged_kit = staging / kit_name
-        write_tree(staged_kit, files)
-        staged_zip = staging / layout.zip_name(robot.name)
-        staged_zip.write_bytes(zip_bytes(files, kit_name))
-        findings: list[Finding] = []
-        if check:
-            say("check")
-            findings = run_checks_cached(staged_kit, files, cache)
-            failed = [f for f in findings if not f.ok]
-            if failed:
-                lines = "; ".join(f.line() for f in failed[:3])
-                more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
-                raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
-        _swap_in(staged_kit, out_dir / kit_name)
-        _swap_in(staged_zip, out_dir / layout.zip_name(robot.name))
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    with atomic.locked(out_dir):  # one build at a time into out_dir (atomic.py)
+        atomic.repair(out_dir, robot.name)
+        staging = atomic.staging(out_dir, robot.name)
+        try:
+            staged_kit = staging / kit_name
+            write_tree(staged_kit, files)
+            staged_zip = staging / layout.zip_name(robot.name)
+            staged_zip.write_bytes(zip_bytes(files, kit_name))
+            findings: list[Finding] = []
+            if check:
+                say("check")
+                findings = run_checks_cached(staged_kit, files, cache)
+                failed = [f for f in findings if not f.ok]
+                if failed:
+                    lines = "; ".join(f.line() for f in failed[:3])
+                    more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
+                    raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
+            atomic.commit(staging, out_dir, robot.name)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
     return BuildResult(
         robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
     )

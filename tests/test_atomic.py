@@ -1,0 +1,141 @@
+"""Crash-consistent publishing (atomic.py): kill -9 at every step leaves the visible kit and
+zip from one build, old or new; the next build cleans up; concurrent builds serialize."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from simkit import atomic, layout
+from simkit.archive import read_zip, zip_bytes
+from simkit.check.generated_check import kit_files
+
+ROBOT = "toy"
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+#: A child process that publishes a synthetic kit (files named by `tag`) with the real code.
+PUBLISH = """
+import sys
+from pathlib import Path
+from simkit import atomic, layout
+from simkit.archive import zip_bytes
+out, robot, tag = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+files = {"robot.json": tag.encode(), f"meshes/{tag}.stl": tag.encode() * 100, "a/b.txt": b"x"}
+with atomic.locked(out):
+    atomic.repair(out, robot)
+    staged = atomic.staging(out, robot)
+    kit = staged / layout.kit_dir_name(robot)
+    for rel, data in files.items():
+        (kit / rel).parent.mkdir(parents=True, exist_ok=True)
+        (kit / rel).write_bytes(data)
+    (staged / layout.zip_name(robot)).write_bytes(zip_bytes(files, layout.kit_dir_name(robot)))
+    atomic.commit(staged, out, robot)
+"""
+
+
+def _files(tag: str) -> dict[str, bytes]:
+    return {"robot.json": tag.encode(), f"meshes/{tag}.stl": tag.encode() * 100, "a/b.txt": b"x"}
+
+
+def _publish(out: Path, tag: str, kill_at: str | None = None) -> int:
+    env = {**os.environ, "PYTHONPATH": SRC}
+    env.pop(atomic.KILL_ENV, None)
+    if kill_at:
+        env[atomic.KILL_ENV] = kill_at
+    cmd = [sys.executable, "-c", PUBLISH, str(out), ROBOT, tag]
+    return subprocess.run(cmd, env=env, timeout=60).returncode
+
+
+def _visible(out: Path) -> tuple[dict[str, bytes], dict[str, bytes]] | None:
+    """(kit files, zip files) as a user sees them, or None when neither exists."""
+    kit, zip_path = out / layout.kit_dir_name(ROBOT), out / layout.zip_name(ROBOT)
+    if not kit.exists() and not zip_path.exists():
+        return None
+    assert kit.is_dir() and zip_path.is_file(), sorted(p.name for p in out.iterdir())
+    files, problems = kit_files(kit)
+    assert not problems
+    return {rel: p.read_bytes() for rel, p in files.items()}, read_zip(zip_path.read_bytes())
+
+
+def _legacy(out: Path, tag: str) -> None:
+    """A plain kit folder and zip, as simkit wrote them before atomic.py."""
+    out.mkdir(parents=True, exist_ok=True)
+    kit = out / layout.kit_dir_name(ROBOT)
+    for rel, data in _files(tag).items():
+        (kit / rel).parent.mkdir(parents=True, exist_ok=True)
+        (kit / rel).write_bytes(data)
+    zip_data = zip_bytes(_files(tag), layout.kit_dir_name(ROBOT))
+    (out / layout.zip_name(ROBOT)).write_bytes(zip_data)
+
+
+@pytest.mark.parametrize("legacy", [False, True], ids=["generations", "legacy"])
+@pytest.mark.parametrize("kill_at", atomic.STEPS)
+def test_kill_at_each_step_leaves_one_build(tmp_path, kill_at, legacy):
+    out = tmp_path / "out"
+    if legacy:
+        _legacy(out, "old")
+    else:
+        assert _publish(out, "old") == 0
+    code = _publish(out, "new", kill_at)
+    reached = kill_at not in atomic.STEPS[2:6] or legacy  # legacy_* steps need a plain kit
+    assert code == (-9 if reached else 0)
+    kit, zipped = _visible(out)
+    assert kit == zipped, "kit and zip come from different builds"
+    assert kit in (_files("old"), _files("new"))
+    if kill_at in ("switched", "linked", "cleaned") or not reached:
+        assert kit == _files("new")
+    # the next build recovers: consistent, and nothing stale is left
+    assert _publish(out, "next") == 0
+    kit, zipped = _visible(out)
+    assert kit == zipped == _files("next")
+    hidden = sorted(p.name for p in out.iterdir() if p.name.startswith("."))
+    assert len(hidden) == 2 and f".{ROBOT}.current" in hidden, hidden
+    assert os.readlink(out / f".{ROBOT}.current") in hidden
+
+
+def test_kill_on_first_build_leaves_nothing_or_new(tmp_path):
+    for kill_at in atomic.STEPS:
+        out = tmp_path / kill_at
+        _publish(out, "new", kill_at)
+        seen = _visible(out)
+        assert seen is None or seen[0] == seen[1] == _files("new"), kill_at
+
+
+def test_concurrent_publishes_serialize(tmp_path):
+    out = tmp_path / "out"
+    codes: list[int] = []
+    threads = [
+        threading.Thread(target=lambda t=tag: codes.append(_publish(out, t)))
+        for tag in ("a", "b", "c", "d")
+    ]
+    for thread in threads:
+        thread.start()
+        time.sleep(0.01)
+    for thread in threads:
+        thread.join()
+    assert codes == [0, 0, 0, 0]
+    kit, zipped = _visible(out)
+    assert kit == zipped and kit in [_files(t) for t in "abcd"]
+    assert not list(out.glob("*.staging")) and len(list(out.glob(".*.gen"))) == 1
+
+
+def test_out_on_a_file_or_unwritable_folder_is_one_line(tmp_path):
+    from simkit.errors import SimkitError
+
+    a_file = tmp_path / "file"
+    a_file.write_text("x")
+    with pytest.raises(SimkitError, match="is a file"), atomic.locked(a_file):
+        pass
+    with pytest.raises(SimkitError, match="cannot create"), atomic.locked(a_file / "sub"):
+        pass
+    if os.getuid() != 0:  # root writes anywhere
+        ro = tmp_path / "ro"
+        ro.mkdir(mode=0o500)
+        with pytest.raises(SimkitError, match="not writable"), atomic.locked(ro):
+            pass
