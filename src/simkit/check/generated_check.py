@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import ast
 import os
-import posixpath
 from pathlib import Path
 
 from simkit import layout
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.kitread import inside
 
 YAML_SUFFIXES = (".yaml", ".yml", ".rviz")
 
@@ -42,14 +42,6 @@ def kit_files(root: Path) -> tuple[dict[str, Path], list[str]]:
                 files[rel] = path
         dirs[:] = [d for d in dirs if not (Path(folder) / d).is_symlink()]
     return files, problems
-
-
-def inside(rel: str) -> bool:
-    """True for a relative POSIX path that stays inside its folder."""
-    if not rel or rel.startswith("/") or "\\" in rel or ":" in rel.partition("/")[0]:
-        return False
-    norm = posixpath.normpath(rel)
-    return norm != ".." and not norm.startswith("../") and norm != "."
 
 
 def _syntax(files: dict[str, Path]) -> list[Finding]:
