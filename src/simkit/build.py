@@ -12,14 +12,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from simkit import atomic, layout
+from simkit import atomic, layout, spec_locate
 from simkit.archive import zip_bytes
 from simkit.cache import Cache
 from simkit.check import run_checks_cached
 from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, usd
-from simkit.errors import CheckFailed, UnknownRobot
+from simkit.errors import CheckFailed, SpecError, UnknownRobot
 from simkit.model import Robot
 from simkit.resolve import resolve
 from simkit.resources import data_dir, robot_names
@@ -67,7 +67,12 @@ def model_from_spec(
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
     robot = resolve(spec, doc.text.encode("utf-8"), shown)
     say("derive solids, mass properties, servos")
-    return derive_all(robot, path.parent, cache, jobs, progress)
+    try:
+        return derive_all(robot, path.parent, cache, jobs, progress)
+    except SpecError as exc:  # raised deep in a step: give it the spec's FILE:LINE
+        raise spec_locate.locate(exc, doc, spec, path.parent) from None
+    except spec_locate.LIBRARY_ERRORS as exc:
+        raise spec_locate.refusal(exc, doc) from exc
 
 
 #: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
