@@ -240,3 +240,29 @@ def test_build_cli_refusals_are_one_line(tmp_path):
     assert _cli("check", str(kit)).returncode == 0
     outside = [p for p in tmp_path.rglob("*") if out not in p.parents and p != out]
     assert sorted(p.name for p in outside) == ["file", "my--robot.yaml"]
+
+
+def test_deep_derive_errors_carry_file_and_line(tmp_path):
+    """An error a derive step raises with only a field (freefall.py: `freefall.pose`) is
+    located in the spec; so is a solid that subtract empties."""
+    from simkit.build import model_from_spec
+    from simkit.cache import Cache
+    from simkit.spec_locate import locate
+    from simkit.yamlsource import load_yaml
+
+    text = GOOD + "freefall:\n  pose: work\n"
+    path = _spec(tmp_path, text)
+    spec, doc = load_spec(path)
+    deep = SpecError("robots/x.yaml", None, "freefall.pose", "released at 'work', ...")
+    err = locate(deep, load_yaml(path), spec, tmp_path)
+    assert (err.file, err.line, err.field) == (str(path), len(text.splitlines()), "freefall.pose")
+    assert doc.line_of(("freefall", "pose")) == err.line
+
+    capsule = "      - {shape: capsule, radius: 0.015, from: [0, 0, 0], to: [0.2, 0, 0]}\n"
+    text = _edit(capsule, capsule + "      - {shape: box, size: [1, 1, 1], subtract: true}\n")
+    path = _spec(tmp_path, text, "empty.yaml")
+    with pytest.raises(SpecError) as info:
+        model_from_spec(str(path), cache=Cache.disabled(), jobs=1)
+    err = info.value
+    assert (err.file, err.field) == (str(path), "links[2].solid") and err.line, str(err)
+    assert "no positive volume" in err.message

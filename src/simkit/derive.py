@@ -18,6 +18,7 @@ from simkit import (
 )
 from simkit.cache import Cache, derived_step
 from simkit.emit import ros2_control
+from simkit.errors import SpecError
 from simkit.kinematics import forward
 from simkit.model import Robot
 
@@ -37,13 +38,15 @@ def derive_solids(robot: Robot, base_dir: Path, cache: Cache | None = None) -> R
 
 def derive_mass(robot: Robot) -> Robot:
     """CoM and inertia from the solid scaled to the link mass, unless the spec gives them."""
-    links = tuple(
-        link
-        if link.inertial is not None
-        else replace(link, inertial=massprops.from_solid(link.solid, link.mass))
-        for link in robot.links
-    )
-    return replace(robot, links=links)
+    links = []
+    for link in robot.links:
+        if link.inertial is None:
+            try:
+                link = replace(link, inertial=massprops.from_solid(link.solid, link.mass))
+            except ValueError as exc:  # e.g. subtract removed the whole solid
+                raise SpecError(link.name, None, "solid", f"link '{link.name}': {exc}") from None
+        links.append(link)
+    return replace(robot, links=tuple(links))
 
 
 def _distance_from_axis(point: np.ndarray, origin: np.ndarray, axis: np.ndarray) -> float:
