@@ -3,6 +3,7 @@ zip from one build, old or new; the next build cleans up; concurrent builds seri
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -139,3 +140,44 @@ def test_out_on_a_file_or_unwritable_folder_is_one_line(tmp_path):
         ro.mkdir(mode=0o500)
         with pytest.raises(SimkitError, match="not writable"), atomic.locked(ro):
             pass
+
+
+@pytest.mark.slow
+def test_kill_a_real_build_at_each_step(tmp_path):
+    """`simkit build` killed (SIGKILL, via the test hook) at each publishing step: the kit
+    and zip on disk are always one build's, and the next build recovers."""
+    spec = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"
+    variants = {}
+    for tag in ("A", "B"):
+        path = tmp_path / tag / "planar_2r.yaml"
+        path.parent.mkdir()
+        path.write_text(spec.read_text().replace("title: Planar 2R", f"title: Planar 2R {tag}"))
+        variants[tag] = path
+    out = tmp_path / "out"
+
+    def build(tag: str, kill_at: str | None = None) -> int:
+        env = {**os.environ, "PYTHONPATH": SRC}
+        env.pop(atomic.KILL_ENV, None)
+        if kill_at:
+            env[atomic.KILL_ENV] = kill_at
+        cmd = [sys.executable, "-m", "simkit.cli", "build", str(variants[tag]), "-q"]
+        return subprocess.run([*cmd, "--out", str(out)], env=env, timeout=600).returncode
+
+    def title() -> str:
+        kit = out / "planar_2r_description"
+        files, problems = kit_files(kit)
+        assert not problems
+        zipped = read_zip((out / "planar-2r-sim-kit.zip").read_bytes())
+        assert zipped == {rel: p.read_bytes() for rel, p in files.items()}
+        return json.loads(zipped["robot.json"])["title"]
+
+    assert build("A") == 0 and title() == "Planar 2R A"
+    old = "A"
+    for kill_at in ("locked", "staged", "generation", "switched", "linked", "cleaned"):
+        new = "B" if old == "A" else "A"
+        assert build(new, kill_at) == -9, kill_at
+        seen = title()
+        assert seen in (f"Planar 2R {old}", f"Planar 2R {new}"), kill_at
+        old = seen[-1]
+    assert build("A") == 0 and title() == "Planar 2R A"
+    assert not list(out.glob(".*.staging")) and len(list(out.glob(".*.gen"))) == 1

@@ -4,8 +4,10 @@ miss with one warning, an unwritable cache never fails a build, and keys are sta
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
+import pytest
 
 from simkit.cache import Cache, digest, make_key
 
@@ -85,3 +87,39 @@ def test_digest_is_the_same_for_numpy_and_python_scalars():
     cached = {"a": [0.1, 3, True], "b": np.arange(3.0)}
     assert digest(computed) == digest(cached)
     assert digest({"a": [0.1]}) != digest({"a": [0.2]})
+
+
+@pytest.mark.slow
+def test_first_rebuild_after_a_cold_build_hits_every_entry(tmp_path):
+    """Issue 13: the `emit` and `derived_freefall` keys used to change on the first rebuild
+    (a cached step returns floats where the computed one had numpy scalars)."""
+    from simkit.build import build
+
+    spec = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"
+    cold = Cache.at(tmp_path / "cache")
+    build(str(spec), tmp_path / "out", cache=cold, jobs=1)
+    assert cold.stats.misses and not cold.stats.hits
+    warm = Cache.at(tmp_path / "cache")
+    build(str(spec), tmp_path / "out", cache=warm, jobs=1)
+    assert warm.stats.misses == {} and warm.stats.repaired == {}
+    assert warm.stats.hits == cold.stats.misses
+    entries = sorted(p.parent.parent.name for p in (tmp_path / "cache").rglob("*.npz"))
+    assert entries == sorted(step for step, n in cold.stats.misses.items() for _ in range(n))
+
+
+@pytest.mark.slow
+def test_build_with_an_unusable_cache_folder_warns_once(tmp_path):
+    import subprocess
+    import sys
+
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    spec = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"
+    cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(tmp_path / "o")]
+    proc = subprocess.run(
+        [*cmd, "-q", "--cache-dir", str(blocker)], capture_output=True, text=True, timeout=600
+    )
+    assert proc.returncode == 0, proc.stderr
+    warnings = [line for line in proc.stderr.splitlines() if line.startswith("simkit: warning:")]
+    assert len(warnings) == 1 and "not writable" in warnings[0], proc.stderr
+    assert "Traceback" not in proc.stderr

@@ -66,6 +66,13 @@ def _named(spec) -> Iterator[tuple[str, Loc, str]]:
     for key in ("poses", "poses_deg"):
         for pose in getattr(spec, key):
             yield "poses", (key, pose), pose
+    if spec.mjcf is not None:
+        for kind in ("defaults", "textures", "materials", "lights", "cameras", "sensors"):
+            for i, item in enumerate(getattr(spec.mjcf, kind)):
+                if item.name is not None:
+                    yield f"mjcf.{kind}", ("mjcf", kind, i, "name"), item.name
+        if spec.mjcf.floor is not None:
+            yield "mjcf.floor", ("mjcf", "floor", "name"), spec.mjcf.floor.name
     if spec.freefall is not None:
         yield "ref", ("freefall", "pose"), spec.freefall.pose
     for key in ("wrist_centre", "tool_frame"):
