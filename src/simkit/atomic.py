@@ -129,9 +129,10 @@ def staging(out_dir: Path, robot: str) -> Path:
     return path
 
 
-def _link(out_dir: Path, target: str, at: Path) -> None:
-    """Point symlink `at` to `target` atomically (a temp link renamed over it)."""
-    tmp = out_dir / f".{at.name}.{secrets.token_hex(4)}.tmp"
+def _link(out_dir: Path, robot: str, target: str, at: Path) -> None:
+    """Point symlink `at` to `target` atomically (a temp link, which `clean` removes if a
+    kill leaves it, renamed over it)."""
+    tmp = out_dir / f".{robot}.{secrets.token_hex(4)}.tmp"
     os.symlink(target, tmp)
     os.replace(tmp, at)
 
@@ -174,11 +175,11 @@ def _adopt_legacy(out_dir: Path, robot: str) -> None:
                 shutil.copy2(path, tmp / path.name)
         step("legacy_copied")
         os.rename(tmp, gen)
-        _link(out_dir, gen.name, _current(out_dir, robot))
+        _link(out_dir, robot, gen.name, _current(out_dir, robot))
         step("legacy_current")
     current = _current(out_dir, robot).name
     if zip_path.exists() and not zip_path.is_symlink():
-        _link(out_dir, f"{current}/{zip_path.name}", zip_path)
+        _link(out_dir, robot, f"{current}/{zip_path.name}", zip_path)
         step("legacy_zip")
     if kit.exists() and not kit.is_symlink():
         tmp = out_dir / f".{robot}.{secrets.token_hex(4)}.tmp"
@@ -197,13 +198,13 @@ def commit(staged: Path, out_dir: Path, robot: str) -> None:
     gen = staged.with_name(staged.name.removesuffix(".staging") + ".gen")
     os.rename(staged, gen)
     step("generation")
-    _link(out_dir, gen.name, _current(out_dir, robot))
+    _link(out_dir, robot, gen.name, _current(out_dir, robot))
     step("switched")
     current = _current(out_dir, robot).name
     for path in _visible(out_dir, robot):
         want = f"{current}/{path.name}"
         if not (path.is_symlink() and os.readlink(path) == want):
-            _link(out_dir, want, path)
+            _link(out_dir, robot, want, path)
     step("linked")
     clean(out_dir, robot)
     step("cleaned")
@@ -216,5 +217,5 @@ def repair(out_dir: Path, robot: str) -> None:
         current = _current(out_dir, robot).name
         for path in _visible(out_dir, robot):
             if not path.exists() and not path.is_symlink():
-                _link(out_dir, f"{current}/{path.name}", path)
+                _link(out_dir, robot, f"{current}/{path.name}", path)
     clean(out_dir, robot)
