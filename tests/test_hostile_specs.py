@@ -266,3 +266,13 @@ def test_deep_derive_errors_carry_file_and_line(tmp_path):
     err = info.value
     assert (err.file, err.field) == (str(path), "links[2].solid") and err.line, str(err)
     assert "no positive volume" in err.message
+
+
+def test_link_without_solid_or_inertia_is_refused(tmp_path):
+    """Found by scripts/fuzz_specs.py: `solid: []` with collision primitives crashed derive."""
+    text = _edit(
+        "      - {shape: cylinder, radius: 0.05, from: [0, 0, 0], to: [0, 0, 0.05]}\n", ""
+    ).replace(
+        "    solid:\n    collision: primitives\n", "    solid: []\n    collision: primitives\n", 1
+    )
+    _refused(tmp_path, text, "links[0].solid", "needs inertia and com")

@@ -77,6 +77,9 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield ("links", i, "com"), "a link that gives its inertia must give its com too"
         if not link.solid and link.collision != "primitives":
             yield ("links", i, "solid"), "a link needs a solid (its visual geometry)"
+        elif not link.solid and link.inertia is None:
+            why = "a link without a solid needs inertia and com (nothing to derive them from)"
+            yield ("links", i, "solid"), why
         if link.collision == "convex" and any(p.subtract or p.shape == "mesh" for p in link.solid):
             yield (
                 ("links", i, "collision"),
