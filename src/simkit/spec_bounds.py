@@ -20,6 +20,8 @@ MAX_TITLE = 200
 MAX_TEXT = 5000  # description, notes
 MAX_STRING = 500  # any other string (sources, plugin names, estimated fields, ...)
 MAX_ANY = 1e6  # any other number
+MAX_BODIES = 256  # links, joints, frames: every step is at least linear in them
+MAX_ITEMS = 1000  # any other list
 
 #: field name -> (low, high, unit) on its absolute value; low applies to non-zero values only
 #: where the field may be zero by default.
@@ -108,6 +110,10 @@ def _walk(value: object, loc: Loc) -> Iterator[Problem]:
                 continue
             yield from _walk(item, (*loc, key))
     elif isinstance(value, (list, tuple)):
+        cap = MAX_BODIES if loc in (("links",), ("joints",), ("frames",)) else MAX_ITEMS
+        if len(value) > cap:
+            yield loc, f"at most {cap} entries (this has {len(value)})"
+            return
         for i, item in enumerate(value):
             yield from _walk(item, (*loc, i))
     elif isinstance(value, bool) or value is None:
@@ -139,6 +145,9 @@ def _joint_range(spec) -> Iterator[Problem]:
 
 def _poses(spec) -> Iterator[Problem]:
     for key, scale in (("poses", 1.0), ("poses_deg", math.pi / 180)):
+        if len(getattr(spec, key)) > MAX_ITEMS:
+            yield (key,), f"at most {MAX_ITEMS} poses"
+            continue
         for pose, values in getattr(spec, key).items():
             for k, value in enumerate(values):
                 if abs(value * scale) > max(2 * math.pi * TURNS, 100.0) * (1 + 1e-12):
