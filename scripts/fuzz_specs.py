@@ -7,6 +7,7 @@ checked with `simkit check`. Counted: refusals (one line), tracebacks or other e
 runs over 60 s, files written outside --out, and exit-0 kits that `simkit check` rejects.
 
     python scripts/fuzz_specs.py --count 10000 --seed 1 --work /tmp/fuzz [--max-seconds N]
+    python scripts/fuzz_specs.py --count 10000 --seed 2 --validate-only   # no builds
 
 Mutations (seeded, so a run is reproducible): perturb a number (mostly still valid, so it
 builds), set a field to a hostile value, delete or add a key, copy a list item, or edit the
@@ -127,7 +128,7 @@ def _one_line(stderr: str) -> bool:
     return len(lines) == 1 and lines[0].startswith("simkit: error: ")
 
 
-def run_one(spec: Path, out: Path, stats: dict, env: dict) -> str:
+def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -> str:
     """Validate, then build and check; returns the outcome name it counted."""
     from simkit.errors import SpecError
     from simkit.validate import load_spec
@@ -140,6 +141,8 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict) -> str:
     except Exception:  # the fuzzer counts every other exception
         stats.setdefault("examples", []).append(traceback.format_exc(limit=3)[-600:])
         return "traceback"
+    if not build:
+        return "valid_not_built"
     cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out), "-q"]
     start = time.monotonic()
     try:
@@ -169,6 +172,23 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict) -> str:
     return "built_ok" if check.returncode == 0 else "check_rejects_exit0_kit"
 
 
+def _summary(args, done: int, counts: dict, stats: dict, begin: float) -> dict:
+    """The figures so far, also written to WORK/summary.json (after every spec)."""
+    seconds = stats["build_seconds"]
+    summary = {
+        "specs": done,
+        "seed": args.seed,
+        "outcomes": dict(sorted(counts.items())),
+        "builds": len(seconds),
+        "longest_build_s": round(max(seconds), 1) if seconds else 0.0,
+        "wall_s": round(time.monotonic() - begin, 1),
+        "examples": stats.get("examples", [])[:5],
+        "build_refusals": sorted(set(stats.get("build_refusals", [])))[:20],
+    }
+    (args.work / "summary.json").write_text(json.dumps(summary, indent=2))
+    return summary
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--spec", type=Path, default=REPO / "tests/specs/planar_2r.yaml")
@@ -176,6 +196,9 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--work", type=Path, default=Path("/tmp/simkit-fuzz"))
     parser.add_argument("--max-seconds", type=float, default=None, help="stop after this long")
+    parser.add_argument(
+        "--validate-only", action="store_true", help="no builds: validation outcomes only"
+    )
     args = parser.parse_args()
     sys.path.insert(0, str(REPO / "src"))
     env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
@@ -197,25 +220,15 @@ def main() -> None:
         mutated, _what = mutate(text, data, rng)
         spec.write_bytes(mutated.encode("utf-8", "surrogatepass"))
         before = _listing(args.work, out)
-        outcome = run_one(spec, out, stats, env)
+        outcome = run_one(spec, out, stats, env, build=not args.validate_only)
         if _listing(args.work, out) != before:
             counts["files_outside_out"] = counts.get("files_outside_out", 0) + 1
         counts[outcome] = counts.get(outcome, 0) + 1
-        if outcome in ("refused", "built_ok", "build_refused"):
+        if outcome in ("refused", "built_ok", "build_refused", "valid_not_built"):
             shutil.rmtree(case, ignore_errors=True)
         done += 1
-    seconds = stats["build_seconds"]
-    summary = {
-        "specs": done,
-        "seed": args.seed,
-        "outcomes": dict(sorted(counts.items())),
-        "builds": len(seconds),
-        "longest_build_s": round(max(seconds), 1) if seconds else 0.0,
-        "wall_s": round(time.monotonic() - begin, 1),
-        "examples": stats.get("examples", [])[:5],
-        "build_refusals": sorted(set(stats.get("build_refusals", [])))[:20],
-    }
-    (args.work / "summary.json").write_text(json.dumps(summary, indent=2))
+        _summary(args, done, counts, stats, begin)
+    summary = _summary(args, done, counts, stats, begin)
     print(json.dumps(summary, indent=2))
     bad = ("traceback", "over_60s", "files_outside_out", "check_rejects_exit0_kit", "bad_refusal")
     sys.exit(1 if any(counts.get(k) for k in bad) else 0)
