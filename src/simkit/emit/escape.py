@@ -16,8 +16,12 @@ from xml.sax.saxutils import escape as _xml_escape
 
 
 def py(value: object) -> str:
-    """A Python literal that evaluates to `value` (str, number, bool, None)."""
-    return repr(value)
+    """A Python literal that evaluates to `value` (str, number, bool, None): `repr`, with
+    double quotes for a string that holds no quote (the house style of the templates)."""
+    text = repr(value)
+    if isinstance(value, str) and text.startswith("'") and not {"'", '"'} & set(value):
+        return f'"{text[1:-1]}"'
+    return text
 
 
 def pydoc(value: object) -> str:
