@@ -117,7 +117,10 @@ def test_build_with_an_unusable_cache_folder_warns_once(tmp_path):
     spec = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"
     cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(tmp_path / "o")]
     proc = subprocess.run(
-        [*cmd, "-q", "--cache-dir", str(blocker)], capture_output=True, text=True, timeout=600
+        [*cmd, "-q", "--cache-dir", str(blocker / "cache")],
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert proc.returncode == 0, proc.stderr
     warnings = [line for line in proc.stderr.splitlines() if line.startswith("simkit: warning:")]
