@@ -68,9 +68,10 @@ def _writable(out_dir: Path) -> None:
         raise SimkitError(f"{out_dir}: the output folder is not writable")
 
 
-@contextlib.contextmanager
-def locked(out_dir: Path) -> Iterator[None]:
-    """Hold an exclusive `flock` on `out_dir` (waits for another build into it to finish)."""
+def acquire(out_dir: Path, robot: str | None = None) -> int:
+    """Take an exclusive `flock` on `out_dir` (waits for another build into it to finish);
+    with `robot`, then `repair` what a killed build of it left. Returns the fd for
+    `release`."""
     import fcntl
 
     _writable(out_dir)
@@ -78,9 +79,27 @@ def locked(out_dir: Path) -> Iterator[None]:
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
         step("locked")
+        if robot is not None:
+            repair(out_dir, robot)
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
+def release(fd: int) -> None:
+    """Drop the lock `acquire` took (closing the folder's fd releases it)."""
+    os.close(fd)
+
+
+@contextlib.contextmanager
+def locked(out_dir: Path) -> Iterator[None]:
+    """`acquire` ... `release` as a context manager."""
+    fd = acquire(out_dir)
+    try:
         yield
     finally:
-        os.close(fd)  # closing releases the lock
+        release(fd)
 
 
 def _current(out_dir: Path, robot: str) -> Path:

@@ -157,26 +157,26 @@ def build(
     say("emit")
     files = _emit_cached(robot, usd_format, cache)
     kit_name = layout.kit_dir_name(robot.name)
-    with atomic.locked(out_dir):  # one build at a time into out_dir (atomic.py)
-        atomic.repair(out_dir, robot.name)
-        staging = atomic.staging(out_dir, robot.name)
-        try:
-            staged_kit = staging / kit_name
-            write_tree(staged_kit, files)
-            staged_zip = staging / layout.zip_name(robot.name)
-            staged_zip.write_bytes(zip_bytes(files, kit_name))
-            findings: list[Finding] = []
-            if check:
-                say("check")
-                findings = run_checks_cached(staged_kit, files, cache)
-                failed = [f for f in findings if not f.ok]
-                if failed:
-                    lines = "; ".join(f.line() for f in failed[:3])
-                    more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
-                    raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
-            atomic.commit(staging, out_dir, robot.name)
-        finally:
-            shutil.rmtree(staging, ignore_errors=True)
+    lock = atomic.acquire(out_dir, robot.name)  # one build at a time into out_dir
+    staging = atomic.staging(out_dir, robot.name)
+    try:
+        staged_kit = staging / kit_name
+        write_tree(staged_kit, files)
+        staged_zip = staging / layout.zip_name(robot.name)
+        staged_zip.write_bytes(zip_bytes(files, kit_name))
+        findings: list[Finding] = []
+        if check:
+            say("check")
+            findings = run_checks_cached(staged_kit, files, cache)
+            failed = [f for f in findings if not f.ok]
+            if failed:
+                lines = "; ".join(f.line() for f in failed[:3])
+                more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
+                raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
+        atomic.commit(staging, out_dir, robot.name)  # kit and zip as one unit (atomic.py)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+        atomic.release(lock)
     return BuildResult(
         robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
     )
