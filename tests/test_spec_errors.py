@@ -232,9 +232,12 @@ def test_yaml_line_map_points_at_keys(tmp_path):
 def test_mass_sign_property(tmp_path_factory, mass):
     path = tmp_path_factory.mktemp("m") / "s.yaml"
     path.write_text(GOOD.replace("    mass: 7.2\n", f"    mass: {mass!r}\n", 1))
-    if mass > 0:
+    if mass >= 1e-4:  # the plausibility floor (spec_bounds.FIELD_BOUNDS)
         spec, _ = load_spec(path)
         assert spec.links[1].mass == mass
+    elif mass > 0:
+        with pytest.raises(SpecError, match="too small to simulate"):
+            load_spec(path)
     else:
         with pytest.raises(SpecError, match="mass must be > 0"):
             load_spec(path)

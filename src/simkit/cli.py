@@ -31,7 +31,7 @@ def main() -> None:
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=click.Path(path_type=Path),  # a file here is refused in one line (atomic.py)
     default=Path("build"),
     show_default=True,
     help="Folder for kits and zips.",

@@ -20,8 +20,8 @@ import numpy as np
 
 from simkit.errors import SimkitError
 from simkit.kitio import layout
-from simkit.kitio.archive import read_zip
 from simkit.kitio.fmt import num
+from simkit.kitio.kitread import read_folder_safely, read_zip_safely, robot_json_problem
 from simkit.kitio.stl import from_stl
 
 #: robot.json joint fields compared, with their units (angles of prismatic joints are m).
@@ -91,13 +91,13 @@ class Report:
 
 
 def _read_zip(path: Path) -> dict[str, bytes]:
-    """Files of a kit zip (`archive.read_zip`), or a one-line error for anything else."""
-    import zipfile
-
-    try:
-        return read_zip(path.read_bytes())
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
-        raise SimkitError(f"{path}: not a kit zip ({exc})") from None
+    """Files of a kit zip, keyed by path inside the kit (`archive.read_zip`'s top-folder
+    rule), read with `kitread`'s caps, or a one-line error for anything else."""
+    files = read_zip_safely(path)
+    tops = {name.partition("/")[0] if "/" in name else None for name in files}
+    if len(tops) == 1 and None not in tops:
+        return {name.partition("/")[2]: data for name, data in files.items()}
+    return files
 
 
 def load_kit(path: Path) -> dict[str, bytes]:
@@ -106,19 +106,14 @@ def load_kit(path: Path) -> dict[str, bytes]:
     if path.is_file():
         files = _read_zip(path)
     elif path.is_dir():
-        files = {
-            p.relative_to(path).as_posix(): p.read_bytes()
-            for p in sorted(path.rglob("*"))
-            if p.is_file() and "__pycache__" not in p.parts
-        }
+        files = read_folder_safely(path)
     else:
         raise SimkitError(f"{path}: no such kit folder or zip")
     if layout.ROBOT_JSON not in files:
         raise SimkitError(f"{path}: not a kit (no {layout.ROBOT_JSON} at its top)")
-    try:
-        json.loads(files[layout.ROBOT_JSON])
-    except ValueError as exc:
-        raise SimkitError(f"{path}: {layout.ROBOT_JSON} is not valid JSON ({exc})") from None
+    why = robot_json_problem(files[layout.ROBOT_JSON])
+    if why:
+        raise SimkitError(f"{path}: {layout.ROBOT_JSON} {why}")
     return files
 
 

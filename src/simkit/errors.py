@@ -20,6 +20,9 @@ class SpecError(SimkitError):
         self.more = more
         super().__init__(str(self))
 
+    def __reduce__(self):  # picklable across worker processes (its __init__ takes 5 args)
+        return (type(self), (self.file, self.line, self.field, self.message, self.more))
+
     def __str__(self) -> str:
         where = f"{self.file}:{self.line}" if self.line is not None else self.file
         tail = f" (and {self.more} more error{'s' if self.more != 1 else ''})" if self.more else ""

@@ -8,9 +8,7 @@ place; a failure at any step leaves the previous kit and zip untouched.
 
 from __future__ import annotations
 
-import os
 import shutil
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,14 +17,15 @@ from simkit.check import run_checks_cached
 from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
-from simkit.errors import CheckFailed, UnknownRobot
-from simkit.kitio import layout
+from simkit.errors import CheckFailed, SpecError, UnknownRobot
+from simkit.kitio import atomic, layout
 from simkit.kitio.archive import zip_bytes
 from simkit.kitio.cache import Arrays, Cache, cached_stage, decode_json, digest, encode_json
 from simkit.kitio.resources import data_dir, robot_names
 from simkit.model.resolve import resolve
 from simkit.model.robot import Robot
 from simkit.simulate import simulate_all
+from simkit.spec import locate as spec_locate
 from simkit.spec.validate import load_spec
 
 Progress = Callable[[str], None]
@@ -71,7 +70,19 @@ def model_from_spec(
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
     robot = resolve(spec, doc.text.encode("utf-8"), shown)
     say("derive solids, mass properties, servos")
-    return derive_all(robot, path.parent, cache, jobs, progress)
+    try:
+        return derive_all(robot, path.parent, cache, jobs, progress)
+    except SpecError as exc:  # raised deep in a step: give it the spec's FILE:LINE
+        raise spec_locate.locate(exc, doc, spec, path.parent) from None
+    except spec_locate.LIBRARY_ERRORS as exc:
+        raise spec_locate.refusal(exc, doc) from exc
+
+
+def _located(target: str, exc: SpecError) -> SpecError:
+    """A SpecError from a stage after derive, with the spec's FILE:LINE where it can be found."""
+    path, shown = find_spec(target)
+    spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
+    return spec_locate.locate(exc, doc, spec, path.parent)
 
 
 #: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
@@ -181,18 +192,6 @@ def write_tree(root: Path, files: dict[str, bytes]) -> None:
         target.write_bytes(data)
 
 
-def _swap_in(staged: Path, final: Path) -> None:
-    """Replace `final` with `staged`, keeping the old one until the new one is in place."""
-    old = final.with_name(f".{final.name}.old")
-    if old.exists():
-        shutil.rmtree(old) if old.is_dir() else old.unlink()
-    if final.exists():
-        os.replace(final, old)
-    os.replace(staged, final)
-    if old.exists():
-        shutil.rmtree(old) if old.is_dir() else old.unlink()
-
-
 def build(
     target: str,
     out_dir: Path,
@@ -211,14 +210,17 @@ def build(
     robot = model_from_spec(target, progress, cache, jobs)
     say("emit")
     files = emit_cached(robot, usd_format, cache, step)
-    out_dir.mkdir(parents=True, exist_ok=True)
     kit_name = layout.kit_dir_name(robot.name)
-    staging = Path(tempfile.mkdtemp(prefix=f".{robot.name}.", suffix=".staging", dir=out_dir))
+    lock = atomic.acquire(out_dir, robot.name)  # one build at a time into out_dir
+    staging = atomic.staging(out_dir, robot.name)
     try:
         staged_kit = staging / kit_name
         write_tree(staged_kit, files)
         say("simulate")
-        reports = simulate_cached(staged_kit, robot, cache, step)
+        try:
+            reports = simulate_cached(staged_kit, robot, cache, step)
+        except SpecError as exc:  # e.g. freefall.pose: a release that leaves the limits
+            raise _located(target, exc) from None
         clash = sorted(set(files) & set(reports))
         if clash:
             raise RuntimeError(f"a model emitter and a report emitter both write {clash[0]}")
@@ -235,10 +237,10 @@ def build(
                 lines = "; ".join(f.line() for f in failed[:3])
                 more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
                 raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
-        _swap_in(staged_kit, out_dir / kit_name)
-        _swap_in(staged_zip, out_dir / layout.zip_name(robot.name))
+        atomic.commit(staging, out_dir, robot.name)  # kit and zip as one unit (atomic.py)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+        atomic.release(lock)
     return BuildResult(
         robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
     )

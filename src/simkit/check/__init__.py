@@ -11,6 +11,7 @@ from pathlib import Path
 
 from simkit.check.findings import Finding, require
 from simkit.check.freefall import check_freefall
+from simkit.check.generated import check_generated
 from simkit.check.geometry import check_collision, check_glb
 from simkit.check.kit import Kit
 from simkit.check.legged import check_legged
@@ -41,6 +42,7 @@ CHECKS: dict[str, Check] = {
     "freefall": check_freefall,
     "self_collision": check_self_collision,
     "step": check_step,
+    "generated": check_generated,
 }
 
 

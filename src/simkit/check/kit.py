@@ -21,8 +21,16 @@ class Kit:
 
     @staticmethod
     def open(path: Path) -> Kit:
+        from simkit.kitio.kitread import read_folder_safely, robot_json_problem
+
         if not (path / "robot.json").is_file():
             raise SimkitError(f"{path}: not a kit folder (no robot.json)")
+        read_folder_safely(
+            path, read=False
+        )  # one-line refusal: symlinks, special or oversized files
+        why = robot_json_problem((path / "robot.json").read_bytes())
+        if why:
+            raise SimkitError(f"{path}: robot.json {why}")
         return Kit(path)
 
     def path(self, relative: str) -> Path:

@@ -158,7 +158,7 @@ def cycle(robot: Robot, arm: ik.ArmChain, name: str, payload: float) -> Cycle:
 
 def payload_on_link(arm: ik.ArmChain, mass: float) -> dict:
     """The payload model plus its CoM in link 6's frame (for attaching it in MuJoCo)."""
-    out = motion.payload_model(mass)
+    out = motion.payload_model(mass, arm.tool)
     out["link"] = arm.children[5]
     out["com_link"] = list(motion.payload_body(arm, mass)[2])
     return out

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from simkit.errors import SpecError
 from simkit.model import inertia
 from simkit.model.robot import Inertial, Robot
 from simkit.spec.schema import InertiaSpec
@@ -25,13 +26,15 @@ Tensor6 = tuple[float, float, float, float, float, float]
 
 def derive_mass(robot: Robot) -> Robot:
     """CoM and inertia from the solid scaled to the link mass, unless the spec gives them."""
-    links = tuple(
-        link
-        if link.inertial is not None
-        else replace(link, inertial=inertia.from_solid(link.solid, link.mass))
-        for link in robot.links
-    )
-    return replace(robot, links=links)
+    links = []
+    for link in robot.links:
+        if link.inertial is None:
+            try:
+                link = replace(link, inertial=inertia.from_solid(link.solid, link.mass))
+            except ValueError as exc:  # e.g. subtract removed the whole solid
+                raise SpecError(link.name, None, "solid", f"link '{link.name}': {exc}") from None
+        links.append(link)
+    return replace(robot, links=tuple(links))
 
 
 def balanced(tensor: Tensor6) -> Tensor6:

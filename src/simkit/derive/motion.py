@@ -38,12 +38,12 @@ DRIVE_METHOD = (
 )
 
 
-def payload_model(mass: float) -> dict:
-    """The payload as robot.json describes it (tool0 frame, SI)."""
+def payload_model(mass: float, frame: str = "tool0") -> dict:
+    """The payload as robot.json describes it (in the tool frame `frame`, SI)."""
     moment = mass * 2 * PAYLOAD_CUBE_EDGE**2 / 12
     return {
         "mass": mass,
-        "frame": "tool0",
+        "frame": frame,
         "com_xyz": list(PAYLOAD_COM_TOOL),
         "inertia_diag": [moment, moment, moment],
         "inertia_model": f"uniform cube, edge {PAYLOAD_CUBE_EDGE:g} m, about its CoM",
@@ -94,7 +94,7 @@ def _case(robot: Robot, arm: ArmChain, pose: str, mass: float) -> dict:
         "pose": pose,
         "q": list(q),
         "payload_kg": mass,
-        "payload": payload_model(mass),
+        "payload": payload_model(mass, arm.tool),
         "rad_s2": list(acc),
         "deg_s2": _deg(acc),
         "gravity_torque": list(g),
@@ -154,7 +154,7 @@ def motion_block(robot: Robot, arm: ArmChain) -> tuple[dict, dict]:
         "derived_max_acceleration": {
             "method": METHOD,
             "joints": list(arm.names),
-            "payload_model": payload_model(rated),
+            "payload_model": payload_model(rated, arm.tool),
             "stretched_rated_payload": stretched,
             "work_1kg": work,
             "note": "conservative: effort_peak is the torque the gearbox passes to the arm, "

@@ -88,9 +88,9 @@ def _shape_hull(shape: Shape, base_dir: Path) -> Mesh:
     STL files are read without trimesh; any mesh may be open (only its hull is used)."""
     import manifold3d as mf
 
-    from simkit.kinematics import rpy_matrix
-    from simkit.solids import primitive_solid, to_mesh
-    from simkit.stl import from_stl
+    from simkit.derive.solids import primitive_solid, to_mesh
+    from simkit.kitio.stl import from_stl
+    from simkit.model.kinematics import rpy_matrix
 
     if shape.kind != "mesh":
         return to_mesh(primitive_solid(shape).hull())

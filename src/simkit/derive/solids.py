@@ -30,9 +30,16 @@ def _load_mesh(shape: Shape, base_dir: Path) -> mf.Manifold:
     path = (base_dir / shape.file).resolve() if shape.file else None
     if path is None or not path.is_file():
         raise SpecError(str(base_dir), None, "solid.file", f"mesh file not found: {shape.file}")
-    mesh = trimesh.load_mesh(path, force="mesh", process=True)
-    verts = np.asarray(mesh.vertices, dtype=np.float32) * shape.scale
-    solid = mf.Manifold(mf.Mesh(vert_properties=verts, tri_verts=np.asarray(mesh.faces, np.uint32)))
+    try:
+        mesh = trimesh.load_mesh(path, force="mesh", process=True)
+        verts = np.asarray(mesh.vertices, dtype=np.float32) * shape.scale
+        faces = np.asarray(mesh.faces, np.uint32)
+    except Exception as exc:  # trimesh raises many kinds on a file it cannot read
+        why = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+        raise SpecError(str(path), None, "solid.file", f"cannot read mesh: {why}") from None
+    if faces.ndim != 2 or len(faces) == 0:
+        raise SpecError(str(path), None, "solid.file", "mesh has no triangles")
+    solid = mf.Manifold(mf.Mesh(vert_properties=verts, tri_verts=faces))
     if solid.status() != mf.Error.NoError or solid.is_empty():
         raise SpecError(str(path), None, "solid.file", "mesh is not a closed, manifold solid")
     return solid

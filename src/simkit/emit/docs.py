@@ -22,7 +22,9 @@ from simkit.model.robot import Robot
 @cache
 def environment() -> jinja2.Environment:
     """The template environment shared by every text emitter."""
-    return jinja2.Environment(
+    from simkit.emit.escape import FILTERS
+
+    env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
         undefined=jinja2.StrictUndefined,
         keep_trailing_newline=True,
@@ -30,6 +32,8 @@ def environment() -> jinja2.Environment:
         lstrip_blocks=True,
         autoescape=False,
     )
+    env.filters.update(FILTERS)  # every value goes through its language's filter (escape.py)
+    return env
 
 
 def _deg(value: float | None) -> str:

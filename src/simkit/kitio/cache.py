@@ -19,6 +19,7 @@ import hashlib
 import io
 import json
 import os
+import sys
 import tempfile
 import zipfile
 from collections.abc import Callable, Mapping
@@ -32,6 +33,7 @@ from simkit import __version__
 
 ENV_DIR = "SIMKIT_CACHE_DIR"
 _DIGEST = "__sha256__"
+_KEY = "__key__"
 
 Arrays = dict[str, np.ndarray]
 
@@ -141,6 +143,7 @@ class Cache:
     root: Path | None
     enabled: bool = True
     stats: Stats = field(default_factory=Stats)
+    warned: set[str] = field(default_factory=set)
 
     @staticmethod
     def at(root: Path | str | None = None, enabled: bool = True) -> Cache:
@@ -156,44 +159,86 @@ class Cache:
         return self.root / step / key[:2] / f"{key}.npz"
 
     def get(self, step: str, key: str) -> Arrays | None:
-        """The stored arrays, or None on a miss. A corrupt entry is deleted and counted."""
+        """The stored arrays, or None on a miss. An entry that is not a readable file holding
+        this key's arrays (corrupt, a folder, another key's content) is removed, counted as
+        repaired, and reported once with a one-line warning."""
         if not self.enabled:
             return None
         path = self.path(step, key)
         try:
-            data = path.read_bytes()
-        except OSError:
+            present, plain = path.is_symlink() or path.exists(), path.is_file()
+        except OSError:  # an unreadable cache folder: a miss
+            present = plain = False
+        if not present:
             self.stats.bump(self.stats.misses, step)
             return None
-        arrays = _decode(data)
+        arrays = None
+        if plain and not path.is_symlink():
+            try:
+                arrays = _decode(path.read_bytes(), key)
+            except OSError:
+                arrays = None
+            except _OldFormat:
+                self.stats.bump(self.stats.misses, step)
+                return None  # `put` replaces it
         if arrays is None:
-            path.unlink(missing_ok=True)
-            self.stats.bump(self.stats.repaired, step)
+            self._repair(step, path)
             self.stats.bump(self.stats.misses, step)
             return None
         self.stats.bump(self.stats.hits, step)
         return arrays
 
+    def _repair(self, step: str, path: Path) -> None:
+        """Remove a bad entry (file, link or folder) so the step rewrites it."""
+        self.stats.bump(self.stats.repaired, step)
+        try:
+            if path.is_dir() and not path.is_symlink():
+                import shutil
+
+                shutil.rmtree(path)
+            else:
+                path.unlink(missing_ok=True)
+        except OSError as exc:
+            self._warn(f"cannot remove a bad '{step}' cache entry ({exc.strerror}): {path}", step)
+            return
+        self._warn(
+            f"a '{step}' cache entry was unreadable or not its key's; recomputed: {path}", step
+        )
+
+    def _warn(self, message: str, topic: str) -> None:
+        """One line on stderr, once per topic (a step's repairs, an unwritable folder)."""
+        if topic not in self.warned:
+            self.warned.add(topic)
+            print(f"simkit: warning: {message}", file=sys.stderr)
+
     def put(self, step: str, key: str, arrays: Arrays) -> None:
-        """Store atomically: write a temp file beside the entry, then `os.replace` it."""
+        """Store atomically: write a temp file beside the entry, then `os.replace` it. The
+        entry holds its key, inside its digest. A cache that cannot be written (read-only,
+        full) is a warning, never a failed build."""
         if not self.enabled:
             return
         payload = {name: np.ascontiguousarray(a) for name, a in arrays.items()}
         if any(a.dtype.hasobject for a in payload.values()):
             raise TypeError("cache entries hold plain arrays only (no pickled objects)")
-        path = self.path(step, key)
-        path.parent.mkdir(parents=True, exist_ok=True)
+        payload[_KEY] = np.frombuffer(key.encode("ascii"), dtype=np.uint8)
         payload[_DIGEST] = np.frombuffer(_content_digest(payload).encode("ascii"), dtype=np.uint8)
         buf = io.BytesIO()
         np.savez(buf, **payload)
-        fd, tmp = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".tmp", dir=path.parent)
+        path = self.path(step, key)
+        tmp = None
         try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if path.is_dir() and not path.is_symlink():
+                self._repair(step, path)
+            fd, tmp = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".tmp", dir=path.parent)
             with os.fdopen(fd, "wb") as handle:
                 handle.write(buf.getvalue())
             os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        except OSError as exc:
+            if tmp is not None:
+                Path(tmp).unlink(missing_ok=True)
+            why = f"cache folder {self.root} is not writable ({exc.strerror}); results not cached"
+            self._warn(why, "<write>")
 
     def memo(self, step: str, key: str, compute: Callable[[], Arrays]) -> Arrays:
         """`get`, else `compute` and `put`."""
@@ -205,17 +250,29 @@ class Cache:
         return result
 
 
-def _decode(data: bytes) -> Arrays | None:
-    """Arrays of an entry, or None when it is unreadable or its digest does not match."""
+def _decode(data: bytes, key: str) -> Arrays | None:
+    """Arrays of an entry, or None when it is unreadable, its digest does not match, or it
+    holds another key's content (entries are bound to their key)."""
     try:
         with np.load(io.BytesIO(data), allow_pickle=False) as npz:
+            if not isinstance(npz, np.lib.npyio.NpzFile):
+                return None
             arrays = {name: npz[name] for name in npz.files}
-    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile):
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, RuntimeError):
         return None
     stored = arrays.pop(_DIGEST, None)
     if stored is None or stored.tobytes().decode("ascii", "replace") != _content_digest(arrays):
         return None
+    bound = arrays.pop(_KEY, None)
+    if bound is None:  # written before entries held their key: an old format, not damage
+        raise _OldFormat
+    if bound.tobytes() != key.encode("ascii"):
+        return None
     return arrays
+
+
+class _OldFormat(Exception):
+    """An intact entry from a simkit that did not store keys: a silent miss."""
 
 
 # --- whole-robot derive steps -----------------------------------------------------------
@@ -240,7 +297,9 @@ _CODE_DIGEST: str | None = None
 
 def digest(value: object) -> str:
     """SHA-256 of a value's content: dataclasses by field, pydantic models by dump, arrays by
-    bytes, floats by repr. Used to key a step on the whole `Robot` it reads."""
+    bytes, floats by repr, numpy scalars as the Python numbers they equal (a cached step
+    returns `float` where a computed one returned `np.float64`: both must give one key, or
+    the first rebuild after a cold build misses). Used to key a step on the whole `Robot`."""
     from dataclasses import fields, is_dataclass
 
     h = hashlib.sha256()
@@ -270,6 +329,8 @@ def digest(value: object) -> str:
             for item in v:
                 feed(item)
             h.update(b"]")
+        elif isinstance(v, np.generic) and not isinstance(v, np.ndarray):
+            feed(v.item())  # a numpy scalar digests as the Python number it equals
         else:
             h.update(f"{type(v).__name__}:{v!r};".encode())
 

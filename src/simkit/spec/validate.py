@@ -14,7 +14,9 @@ import numpy as np
 from pydantic import ValidationError
 
 from simkit.errors import SpecError
+from simkit.spec import bounds as spec_bounds
 from simkit.spec import mjcf as spec_mjcf
+from simkit.spec import names as spec_names
 from simkit.spec import sim as spec_sim
 from simkit.spec.load import Loc, SourceDoc, dotted, load_yaml
 from simkit.spec.schema import InertiaSpec, RobotSpec, depth_first
@@ -51,6 +53,8 @@ def _fmt3(values: np.ndarray) -> str:
 
 
 def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
+    yield from spec_names.problems(spec)
+    yield from spec_bounds.problems(spec)
     links = {link.name: i for i, link in enumerate(spec.links)}
     materials = {m.name for m in spec.materials}
     names_seen: dict[str, Loc] = {spec.root: ("root",)}
@@ -78,6 +82,9 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield ("links", i, "collision_shapes"), "'given' collision needs collision_shapes"
         if not link.solid and link.collision != "primitives":
             yield ("links", i, "solid"), "a link needs a solid (its visual geometry)"
+        elif not link.solid and link.inertia is None:
+            why = "a link without a solid needs inertia and com (nothing to derive them from)"
+            yield ("links", i, "solid"), why
         if link.collision == "convex" and any(p.subtract or p.shape == "mesh" for p in link.solid):
             yield (
                 ("links", i, "collision"),

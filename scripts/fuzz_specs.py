@@ -1,0 +1,238 @@
+"""Long-run spec fuzzer (issue 13): mutate a small spec many times and build each mutation.
+
+Every mutation is validated in-process first (`validate.load_spec`, the code `simkit build`
+runs first); one that validates is built with the real CLI in a subprocess
+(`python -m simkit.cli build SPEC --out DIR`, 60 s limit), and a kit it exits 0 with is
+checked with `simkit check`. Counted: refusals (one line), tracebacks or other exceptions,
+runs over 60 s, files written outside --out, and exit-0 kits that `simkit check` rejects.
+
+    python scripts/fuzz_specs.py --count 10000 --seed 1 --work /tmp/fuzz [--max-seconds N]
+    python scripts/fuzz_specs.py --count 10000 --seed 2 --validate-only   # no builds
+
+Mutations (seeded, so a run is reproducible): perturb a number (mostly still valid, so it
+builds), set a field to a hostile value, delete or add a key, copy a list item, or edit the
+raw YAML text (insert/cut characters and YAML syntax such as anchors, tags, merge keys, NUL).
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import yaml
+
+REPO = Path(__file__).resolve().parents[1]
+HOSTILE = [
+    "",
+    "../../x",
+    'a"""b',
+    "a\nb",
+    "x" * 300,
+    "tool0_joint",
+    "link_1_collision_00",
+    "LINK_1",
+    "joint-1",
+    "on",
+    "null",
+    "<x/>",
+    None,
+    True,
+    -1,
+    0,
+    1e-12,
+    1e12,
+    1e308,
+    36000,
+    [],
+    {},
+    [1, 2, 3],
+    {"a": 1},
+]
+SNIPPETS = ["<<: *a", "&a ", "*a", "!!python/object:os.system ", "!foo ", "\x00", "[" * 60]
+SNIPPETS += ["{", "- ", ": ", "\t", "'", '"', "---\n", "~", "? ", "1e999", "\n  - ", "-"]
+
+
+def _paths(value: object, prefix: tuple = ()) -> list[tuple]:
+    out = [prefix]
+    if isinstance(value, dict):
+        for key, item in value.items():
+            out += _paths(item, (*prefix, key))
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            out += _paths(item, (*prefix, i))
+    return out
+
+
+def mutate(text: str, data: dict, rng: random.Random) -> tuple[str, str]:
+    """(mutated YAML text, what was done)."""
+    kind = rng.choices(["perturb", "structure", "raw"], weights=[4, 3, 3])[0]
+    if kind == "raw":
+        for _ in range(rng.randint(1, 3)):
+            at = rng.randint(0, len(text))
+            insert = rng.choice(SNIPPETS) if rng.random() < 0.7 else chr(rng.randint(32, 126))
+            text = text[:at] + insert + text[at + rng.randint(0, 20) :]
+        return text, "raw"
+    out = copy.deepcopy(data)
+    paths = [p for p in _paths(out) if p]
+    if kind == "perturb":
+        numeric = [p for p in paths if _get(out, p).__class__ in (int, float)]
+        path = rng.choice(numeric)
+        value = _get(out, path)
+        factor = rng.choice([0.5, 0.9, 1.1, 2.0, -1.0, 10.0, 0.0])
+        new = value * factor + (rng.random() * 0.01 if factor == 0.0 else 0.0)
+        _set(out, path, type(value)(new) if isinstance(value, int) else new)
+        return yaml.safe_dump(out, allow_unicode=True), f"perturb {path}"
+    path = rng.choice(paths)
+    action = rng.choice(["set", "delete", "add", "copy"])
+    parent = _get(out, path[:-1])
+    if action == "delete":
+        del parent[path[-1]]
+    elif action == "add" and isinstance(parent, dict):
+        parent[f"{path[-1]}_x"] = rng.choice(HOSTILE)
+    elif action == "copy" and isinstance(parent, list):
+        parent.append(copy.deepcopy(parent[path[-1]]))
+    else:
+        parent[path[-1]] = copy.deepcopy(rng.choice(HOSTILE))
+    return yaml.safe_dump(out, allow_unicode=True), f"{action} {path}"
+
+
+def _get(data, path):
+    for part in path:
+        data = data[part]
+    return data
+
+
+def _set(data, path, value):
+    _get(data, path[:-1])[path[-1]] = value
+
+
+def _listing(root: Path, skip: Path) -> set[str]:
+    return {str(p) for p in root.rglob("*") if skip not in p.parents and p != skip}
+
+
+def _one_line(stderr: str) -> bool:
+    lines = [
+        line
+        for line in stderr.splitlines()
+        if line.strip() and not line.startswith(("[", "simkit: warning:"))
+    ]
+    return len(lines) == 1 and lines[0].startswith("simkit: error: ")
+
+
+def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -> str:
+    """Validate, then build and check; returns the outcome name it counted."""
+    from simkit.errors import SpecError
+    from simkit.spec.validate import load_spec
+
+    try:
+        load_spec(spec)
+    except SpecError as exc:
+        ok = "\n" not in str(exc) and str(exc).startswith(str(spec))
+        return "refused" if ok else "bad_refusal"
+    except Exception:  # the fuzzer counts every other exception
+        stats.setdefault("examples", []).append(traceback.format_exc(limit=3)[-600:])
+        return "traceback"
+    if not build:
+        return "valid_not_built"
+    cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out), "-q"]
+    start = time.monotonic()
+    try:
+        proc = subprocess.run(
+            cmd, capture_output=True, text=True, timeout=60, env=env, cwd=spec.parent
+        )
+    except subprocess.TimeoutExpired:
+        return "over_60s"
+    stats["build_seconds"].append(time.monotonic() - start)
+    if "Traceback" in proc.stderr + proc.stdout:
+        stats.setdefault("examples", []).append(proc.stderr[-600:])
+        return "traceback"
+    if proc.returncode != 0:
+        if not _one_line(proc.stderr):
+            stats.setdefault("examples", []).append(proc.stderr[-600:])
+            return "bad_refusal"
+        stats.setdefault("build_refusals", []).append(proc.stderr.strip().splitlines()[-1][:300])
+        return "build_refused"
+    kits = [p for p in out.iterdir() if p.name.endswith("_description")]
+    check = subprocess.run(
+        [sys.executable, "-m", "simkit.cli", "check", str(kits[0])],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    return "built_ok" if check.returncode == 0 else "check_rejects_exit0_kit"
+
+
+def _summary(args, done: int, counts: dict, stats: dict, begin: float) -> dict:
+    """The figures so far, also written to WORK/summary.json (after every spec)."""
+    seconds = stats["build_seconds"]
+    summary = {
+        "specs": done,
+        "seed": args.seed,
+        "outcomes": dict(sorted(counts.items())),
+        "builds": len(seconds),
+        "longest_build_s": round(max(seconds), 1) if seconds else 0.0,
+        "wall_s": round(time.monotonic() - begin, 1),
+        "examples": stats.get("examples", [])[:5],
+        "build_refusals": sorted(set(stats.get("build_refusals", [])))[:20],
+    }
+    (args.work / "summary.json").write_text(json.dumps(summary, indent=2))
+    return summary
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--spec", type=Path, default=REPO / "tests/specs/planar_2r.yaml")
+    parser.add_argument("--count", type=int, default=1000)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--work", type=Path, default=Path("/tmp/simkit-fuzz"))
+    parser.add_argument("--max-seconds", type=float, default=None, help="stop after this long")
+    parser.add_argument(
+        "--validate-only", action="store_true", help="no builds: validation outcomes only"
+    )
+    args = parser.parse_args()
+    sys.path.insert(0, str(REPO / "src"))
+    env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
+    text = args.spec.read_text()
+    data = yaml.safe_load(text)
+    rng = random.Random(args.seed)
+    shutil.rmtree(args.work, ignore_errors=True)
+    args.work.mkdir(parents=True)
+    stats: dict = {"build_seconds": []}
+    counts: dict[str, int] = {}
+    begin = time.monotonic()
+    done = 0
+    for i in range(args.count):
+        if args.max_seconds and time.monotonic() - begin > args.max_seconds:
+            break
+        case = args.work / f"{i:05d}"
+        case.mkdir()
+        spec, out = case / "spec.yaml", case / "out"
+        mutated, _what = mutate(text, data, rng)
+        spec.write_bytes(mutated.encode("utf-8", "surrogatepass"))
+        before = _listing(args.work, out)
+        outcome = run_one(spec, out, stats, env, build=not args.validate_only)
+        if _listing(args.work, out) != before:
+            counts["files_outside_out"] = counts.get("files_outside_out", 0) + 1
+        counts[outcome] = counts.get(outcome, 0) + 1
+        if outcome in ("refused", "built_ok", "build_refused", "valid_not_built"):
+            shutil.rmtree(case, ignore_errors=True)
+        done += 1
+        _summary(args, done, counts, stats, begin)
+    summary = _summary(args, done, counts, stats, begin)
+    print(json.dumps(summary, indent=2))
+    bad = ("traceback", "over_60s", "files_outside_out", "check_rejects_exit0_kit", "bad_refusal")
+    sys.exit(1 if any(counts.get(k) for k in bad) else 0)
+
+
+if __name__ == "__main__":
+    main()
