@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import shutil
 import tempfile
 from collections.abc import Callable, Sequence
@@ -25,7 +26,7 @@ from simkit.errors import SimkitError
 from simkit.kitio import layout
 from simkit.kitio.jsonout import dumps
 from simkit.kitio.resources import robot_names
-from simkit.pipeline import _swap_in, build, find_spec, write_tree
+from simkit.pipeline import build, find_spec, write_tree
 from simkit.spec.validate import load_spec
 
 INDEX_FORMAT = 1
@@ -111,3 +112,16 @@ def publish(
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return index
+
+
+def _swap_in(staged: Path, final: Path) -> None:
+    """Replace the site folder `final` with `staged`, keeping the old one until the new one
+    is in place."""
+    old = final.with_name(f".{final.name}.old")
+    if old.exists():
+        shutil.rmtree(old) if old.is_dir() else old.unlink()
+    if final.exists():
+        os.replace(final, old)
+    os.replace(staged, final)
+    if old.exists():
+        shutil.rmtree(old) if old.is_dir() else old.unlink()
