@@ -190,6 +190,15 @@ def _published_limits(joint: dict) -> bool:
     return not marked & {"lower_deg", "upper_deg", "lower", "upper", "limits"}
 
 
+def _limits(joint: dict) -> tuple[float, float]:
+    """robot.json limits (rad or m); a joint without limits (continuous) sweeps one turn."""
+    lower, upper = joint.get("lower"), joint.get("upper")
+    return (
+        -math.pi if lower is None else float(lower),
+        math.pi if upper is None else float(upper),
+    )
+
+
 def _sweeps(kit: Kit, m: _Model) -> list[Finding]:
     """Each joint lower -> upper in 2 deg steps, the others at home."""
     recorded = {
@@ -198,7 +207,7 @@ def _sweeps(kit: Kit, m: _Model) -> list[Finding]:
     }
     out = []
     for i, joint in enumerate(m.joints):
-        lo, hi = float(joint["lower"]), float(joint["upper"])
+        lo, hi = _limits(joint)
         note = ""
         if _published_limits(joint) and joint["name"] in recorded:
             rec = recorded[joint["name"]]
@@ -229,7 +238,8 @@ def _sweeps(kit: Kit, m: _Model) -> list[Finding]:
 def _probe_record(m: _Model, i: int, joint: dict, lo: float, hi: float) -> list[Finding]:
     """A recorded free end inside the published limits must be where contact starts."""
     out = []
-    for end, limit, sign in ((lo, float(joint["lower"]), -1.0), (hi, float(joint["upper"]), 1.0)):
+    lower, upper = _limits(joint)
+    for end, limit, sign in ((lo, lower, -1.0), (hi, upper, 1.0)):
         if abs(end - limit) < 1e-9:
             continue
         q = list(m.home)

@@ -7,6 +7,7 @@ import math
 from simkit.importer.geometry import floats, origin, placed
 from simkit.importer.report import Report
 from simkit.importer.source import Source
+from simkit.spec.bounds import FIELD_BOUNDS
 
 TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating"}
 KNOWN = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
@@ -97,12 +98,22 @@ def _limits(
             if out["lower"] > out["upper"]:
                 raise source.fail(limit, f"lower ({out['lower']}) is greater than upper")
     velocity = 0.0 if limit is None else abs(floats(source, limit, "velocity", 1, "0"))
+    if velocity > FIELD_BOUNDS["max_velocity"][1]:  # a placeholder such as 1000: no real limit
+        report.estimated(
+            source, element, f"velocity {velocity:g} is a placeholder: {VELOCITY[kind]:g}"
+        )
+        velocity = 0.0
+        estimated.append("max_velocity")
     if velocity <= 0:
         velocity = VELOCITY[kind]
-        report.estimated(source, element, f"no velocity limit: {velocity:g}")
-        estimated.append("max_velocity")
+        if "max_velocity" not in estimated:
+            report.estimated(source, element, f"no velocity limit: {velocity:g}")
+            estimated.append("max_velocity")
     out["max_velocity"] = velocity
     effort = 0.0 if limit is None else abs(floats(source, limit, "effort", 1, "0"))
+    if effort > FIELD_BOUNDS["effort_peak"][1]:  # a placeholder: treated as no limit
+        report.estimated(source, element, f"effort {effort:g} is a placeholder")
+        effort = 0.0
     if effort <= 0:
         mass, arm = load
         effort = float(f"{max(1.0, 2.0 * mass * G * (1.0 if kind == 'prismatic' else arm)):.3g}")
