@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import asdict
+from functools import partial
 from pathlib import Path
 
 from simkit.check.findings import Finding, require
@@ -24,6 +25,7 @@ from simkit.check.step import check_step
 from simkit.check.urdf import check_urdf
 from simkit.check.usd import check_usd
 from simkit.kitio.cache import Cache, cached_stage, decode_json, encode_json
+from simkit.kitio.forked import Background
 
 Check = Callable[[Kit], list[Finding]]
 
@@ -49,14 +51,34 @@ CHECKS: dict[str, Check] = {
 def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Finding]:
     """Every finding for the kit at `kit_dir`, in a stable order."""
     kit = Kit.open(kit_dir)
-    findings: list[Finding] = []
-    for name, check in (checks or CHECKS).items():
-        try:
-            findings.extend(check(kit))
-        except Exception as exc:  # a damaged kit (missing or unreadable file): fail, no traceback
-            why = " ".join(f"{type(exc).__name__}: {exc}".split())
-            findings.append(require(f"{name}.error", False, f"the {name} check cannot run: {why}"))
-    return findings
+    checks = checks or CHECKS
+    background = {
+        name: Background(partial(_guarded, name, checks[name], kit))
+        for name in BACKGROUND
+        if name in checks
+    }
+    try:
+        found = {n: _guarded(n, c, kit) for n, c in checks.items() if n not in background}
+        found.update({name: job.result() for name, job in background.items()})
+    finally:
+        for job in background.values():
+            job.close()
+    return [finding for name in checks for finding in found[name]]
+
+
+#: Checks run in a forked child beside the others (kitio/forked.py): the STEP check's Open
+#: CASCADE import and re-read would otherwise add to a cold build's time.
+BACKGROUND = ("step",)
+
+
+def _guarded(name: str, check: Check, kit: Kit) -> list[Finding]:
+    """The check's findings; an exception (a damaged kit: a missing or unreadable file)
+    becomes one failed finding, not a traceback."""
+    try:
+        return check(kit)
+    except Exception as exc:
+        why = " ".join(f"{type(exc).__name__}: {exc}".split())
+        return [require(f"{name}.error", False, f"the {name} check cannot run: {why}")]
 
 
 #: Libraries whose behaviour the findings depend on (part of the cache key).

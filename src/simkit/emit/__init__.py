@@ -6,6 +6,7 @@ Emitters do no I/O, read no clock and draw no random numbers.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 
 from simkit.emit import (
     docs,
@@ -24,6 +25,7 @@ from simkit.emit import (
     urdf,
     usd,
 )
+from simkit.kitio.forked import Background
 from simkit.model.robot import Robot, SimReports
 
 Emitter = Callable[[Robot], dict[str, bytes]]
@@ -45,9 +47,24 @@ EMITTERS: dict[str, Emitter] = {
 }
 
 
+#: Emitters run in a forked child beside the others (kitio/forked.py): the STEP emitter's
+#: Open CASCADE import and B-rep solids are most of a cold STEP kit's extra time.
+BACKGROUND = ("step",)
+
+
 def emit_all(robot: Robot, emitters: dict[str, Emitter] | None = None) -> dict[str, bytes]:
     """Run every model emitter (before the simulate stage)."""
-    return _collect({name: emitter(robot) for name, emitter in (emitters or EMITTERS).items()})
+    emitters = emitters or EMITTERS
+    background = {
+        name: Background(partial(emitters[name], robot)) for name in BACKGROUND if name in emitters
+    }
+    try:
+        outputs = {n: e(robot) for n, e in emitters.items() if n not in background}
+        outputs.update({name: job.result() for name, job in background.items()})
+    finally:
+        for job in background.values():
+            job.close()
+    return _collect({name: outputs[name] for name in emitters})
 
 
 def emit_reports(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, bytes]:

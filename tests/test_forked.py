@@ -1,0 +1,57 @@
+"""kitio/forked.py: work in a forked child gives the in-process value, errors surface here."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from simkit.kitio.forked import Background
+
+
+def test_child_value_comes_back_and_child_is_reaped() -> None:
+    job = Background(lambda: (os.getpid(), b"x" * 3_000_000))
+    assert job._pid > 0  # really forked
+    pid, data = job.result()
+    assert pid != os.getpid() and data == b"x" * 3_000_000
+    assert job._pid == 0
+
+
+def test_failure_in_child_is_raised_in_process() -> None:
+    calls = []
+
+    def work() -> int:
+        calls.append(os.getpid())
+        raise ValueError("degenerate solid")
+
+    job = Background(work)
+    with pytest.raises(ValueError, match="degenerate solid"):
+        job.result()
+    assert calls == [os.getpid()]  # the child's call is not seen here; the rerun is
+
+
+def test_killed_child_falls_back_to_in_process() -> None:
+    parent = os.getpid()
+
+    def work() -> int:
+        if os.getpid() != parent:  # only the child dies
+            os.kill(os.getpid(), 9)
+        return os.getpid()
+
+    job = Background(work)
+    assert job.result() == parent
+
+
+def test_no_fork_runs_in_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SIMKIT_NO_FORK", "1")
+    job = Background(os.getpid)
+    assert job._pid == 0 and job.result() == os.getpid()
+
+
+def test_close_stops_an_unwanted_child() -> None:
+    job = Background(lambda: __import__("time").sleep(60))
+    pid = job._pid
+    job.close()
+    assert job._pid == 0
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)
