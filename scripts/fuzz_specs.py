@@ -2,7 +2,7 @@
 
 Every mutation is validated in-process first (`validate.load_spec`, the code `simkit build`
 runs first); one that validates is built with the real CLI in a subprocess
-(`python -m simkit.cli build SPEC --out DIR`, 60 s limit), and a kit it exits 0 with is
+(`python -m simkit.cli build SPEC --out DIR`, 60 s of CPU per process, 600 s wall backstop), and an exit-0 kit is
 checked with `simkit check`. Counted: refusals (one line), tracebacks or other exceptions,
 runs over 60 s, files written outside --out, and exit-0 kits that `simkit check` rejects.
 
@@ -21,7 +21,9 @@ import copy
 import json
 import os
 import random
+import resource
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -128,6 +130,22 @@ def _one_line(stderr: str) -> bool:
     return len(lines) == 1 and lines[0].startswith("simkit: error: ")
 
 
+#: "Over 60 s" means 60 s of CPU in any one process of the build (RLIMIT_CPU): on a shared
+#: machine, or under `nice`, wall time also counts other people's work. A wall-clock
+#: backstop catches a build that sleeps or waits instead.
+CPU_LIMIT_S = 60
+WALL_BACKSTOP_S = 600
+
+
+def _limit_cpu() -> None:
+    resource.setrlimit(resource.RLIMIT_CPU, (CPU_LIMIT_S, CPU_LIMIT_S + 1))
+
+
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -> str:
     """Validate, then build and check; returns the outcome name it counted."""
     from simkit.errors import SpecError
@@ -144,14 +162,23 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -
     if not build:
         return "valid_not_built"
     cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out), "-q"]
-    start = time.monotonic()
+    start, cpu = time.monotonic(), _children_cpu()
     try:
         proc = subprocess.run(
-            cmd, capture_output=True, text=True, timeout=60, env=env, cwd=spec.parent
+            cmd,
+            capture_output=True,
+            text=True,
+            timeout=WALL_BACKSTOP_S,
+            env=env,
+            cwd=spec.parent,
+            preexec_fn=_limit_cpu,
         )
     except subprocess.TimeoutExpired:
         return "over_60s"
+    if proc.returncode in (-signal.SIGXCPU, -signal.SIGKILL):
+        return "over_60s"
     stats["build_seconds"].append(time.monotonic() - start)
+    stats["build_cpu_seconds"].append(_children_cpu() - cpu)
     if "Traceback" in proc.stderr + proc.stdout:
         stats.setdefault("examples", []).append(proc.stderr[-600:])
         return "traceback"
@@ -181,6 +208,7 @@ def _summary(args, done: int, counts: dict, stats: dict, begin: float) -> dict:
         "outcomes": dict(sorted(counts.items())),
         "builds": len(seconds),
         "longest_build_s": round(max(seconds), 1) if seconds else 0.0,
+        "longest_build_cpu_s": round(max(stats["build_cpu_seconds"], default=0.0), 1),
         "wall_s": round(time.monotonic() - begin, 1),
         "examples": stats.get("examples", [])[:5],
         "build_refusals": sorted(set(stats.get("build_refusals", [])))[:20],
@@ -207,7 +235,7 @@ def main() -> None:
     rng = random.Random(args.seed)
     shutil.rmtree(args.work, ignore_errors=True)
     args.work.mkdir(parents=True)
-    stats: dict = {"build_seconds": []}
+    stats: dict = {"build_seconds": [], "build_cpu_seconds": []}
     counts: dict[str, int] = {}
     begin = time.monotonic()
     done = 0
