@@ -2,9 +2,10 @@
 
 Every mutation is validated in-process first (`validate.load_spec`, the code `simkit build`
 runs first); one that validates is built with the real CLI in a subprocess
-(`python -m simkit.cli build SPEC --out DIR`, 60 s of CPU per process, 600 s wall backstop), and an exit-0 kit is
-checked with `simkit check`. Counted: refusals (one line), tracebacks or other exceptions,
-runs over 60 s, files written outside --out, and exit-0 kits that `simkit check` rejects.
+(`python -m simkit.cli build SPEC --out DIR`, 60 s of CPU per process, 600 s wall
+backstop), and an exit-0 kit is checked with `simkit check`. Counted: refusals (one
+line), tracebacks or other exceptions, runs over 60 s, files written outside --out, and
+exit-0 kits that `simkit check` rejects.
 
     python scripts/fuzz_specs.py --count 10000 --seed 1 --work /tmp/fuzz [--max-seconds N]
     python scripts/fuzz_specs.py --count 10000 --seed 2 --validate-only   # no builds
