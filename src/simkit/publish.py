@@ -9,21 +9,22 @@ files. So the output folder (the site's /assets/sim/) holds:
     1000/robot.json, 1000/urdf/...   the kit's files, one URL each (<model> = spec asset_dir)
 
 The whole folder is built beside the output and swapped in at the end, so a failed build
-leaves the previous publication in place.
+leaves the previous publication in place. Publications into one folder serialize on a lock of
+its parent, and the swap is one `renameat2` exchange (`kitio.atomic.swap_folder`): a kill at
+any instant leaves the old site or the new one, and the next publish removes what it left.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
-import os
 import shutil
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from simkit.errors import SimkitError
-from simkit.kitio import layout
+from simkit.kitio import atomic, layout
 from simkit.kitio.jsonout import dumps
 from simkit.kitio.resources import robot_names
 from simkit.pipeline import build, find_spec, write_tree
@@ -68,6 +69,16 @@ def publish(
     _check_out_dir(out_dir)
     names = list(targets) if targets else robot_names()
     out_dir.parent.mkdir(parents=True, exist_ok=True)
+    with atomic.locked(out_dir.parent):  # one publish into a folder at a time
+        atomic.recover_folder(out_dir)
+        return _publish_locked(out_dir, names, say, build_options)
+
+
+def _publish_locked(
+    out_dir: Path, names: list[str], say: Callable[[str], None], build_options: dict
+) -> dict:
+    """`publish` with the lock held: build every kit and the index into a staging folder
+    beside `out_dir`, then swap it in as one unit (`atomic.swap_folder`)."""
     staging = Path(
         tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".staging", dir=out_dir.parent)
     )
@@ -77,7 +88,7 @@ def publish(
         kits = []
         for target in names:
             say(f"build {target}")
-            result = build(target, work, check=True, progress=progress, **build_options)
+            result = build(target, work, check=True, progress=say, **build_options)
             top = layout.kit_dir_name(result.robot)
             folder = _asset_dir(target, result.robot)
             if any(kit["folder"] == f"{folder}/" for kit in kits):
@@ -108,20 +119,7 @@ def publish(
             "kits": kits,
         }
         (site / layout.INDEX_JSON).write_bytes(dumps(index))
-        _swap_in(site, out_dir)
+        atomic.swap_folder(site, out_dir)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return index
-
-
-def _swap_in(staged: Path, final: Path) -> None:
-    """Replace the site folder `final` with `staged`, keeping the old one until the new one
-    is in place."""
-    old = final.with_name(f".{final.name}.old")
-    if old.exists():
-        shutil.rmtree(old) if old.is_dir() else old.unlink()
-    if final.exists():
-        os.replace(final, old)
-    os.replace(staged, final)
-    if old.exists():
-        shutil.rmtree(old) if old.is_dir() else old.unlink()

@@ -48,6 +48,8 @@ STEPS = (
     "linked",
     "cleaned",
 )
+#: The steps of `swap_folder` (simkit publish's site folder) at which the hook can kill.
+FOLDER_STEPS = ("site_staged", "site_moved_aside", "site_swapped")
 
 
 def step(name: str) -> None:
@@ -238,3 +240,35 @@ def repair(out_dir: Path, robot: str) -> None:
             if not path.exists() and not path.is_symlink():
                 _link(out_dir, robot, f"{current}/{path.name}", path)
     clean(out_dir, robot)
+
+
+def recover_folder(final: Path) -> None:
+    """Before replacing folder `final` (call with `final.parent` locked): put back the old
+    folder a kill left aside (no renameat2), and remove stale `.NAME.*.staging` folders."""
+    old = final.with_name(f".{final.name}.old")
+    if old.is_dir() and not final.exists():
+        os.rename(old, final)
+    _remove(old)
+    for path in sorted(final.parent.glob(f".{final.name}.*.staging")):
+        _remove(path)
+
+
+def swap_folder(staged: Path, final: Path) -> None:
+    """Replace folder `final` by `staged` (call with `final.parent` locked). With renameat2
+    the two are exchanged in one step and the old one removed, so a kill at any instant
+    leaves the old folder or the new one, whole. Without it, the old folder is moved aside
+    first and `recover_folder` puts it back if a kill comes between the two renames."""
+    step("site_staged")
+    if not final.exists():
+        os.rename(staged, final)
+    elif _exchange(staged, final):
+        step("site_swapped")
+        _remove(staged)  # now the old folder
+    else:
+        old = final.with_name(f".{final.name}.old")
+        _remove(old)
+        os.rename(final, old)
+        step("site_moved_aside")
+        os.rename(staged, final)
+        step("site_swapped")
+        _remove(old)
