@@ -78,17 +78,34 @@ def _link(shapes, solid=None):
     return Link("part", 1.0, None, None, tuple(shapes), "convex", solid=solid)
 
 
-def test_mesh_link_of_two_touching_pieces_is_one_valid_solid():
-    """manifold3d keeps two boxes that share a face as two shells; the STEP solid fuses them."""
+def test_mesh_link_pieces_are_separate_valid_solids_without_a_fuse():
+    """manifold3d keeps two boxes that share a face as two shells, and a bolt apart from its
+    part is a third: three faceted solids in one compound, each valid, the volume exact."""
     from OCP.BRepCheck import BRepCheck_Analyzer
 
     foot = mf.Manifold.cube((0.12, 0.08, 0.02), center=True).translate((0.06, 0, 0.01))
     wall = mf.Manifold.cube((0.02, 0.08, 0.10), center=True).translate((0.01, 0, 0.07))
-    mesh = to_mesh(foot + wall)
-    solid = brep.link_shape(_link([_shape("mesh", file="x.stl")], solid=mesh))
-    assert len(step_reader.solids_of(solid)) == 1
-    assert BRepCheck_Analyzer(solid).IsValid()
-    assert step_reader.volume(solid) == pytest.approx(120 * 80 * 20 + 20 * 80 * 100, rel=1e-9)
+    bolt = mf.Manifold.cube((0.01, 0.01, 0.01), center=True).translate((0.3, 0, 0))
+    mesh = to_mesh(foot + wall + bolt)
+    shape = brep.link_shape(_link([_shape("mesh", file="x.stl")], solid=mesh))
+    solids = step_reader.solids_of(shape)
+    assert len(solids) == 3
+    assert all(BRepCheck_Analyzer(s).IsValid() for s in solids)
+    expected = 120 * 80 * 20 + 20 * 80 * 100 + 10 * 10 * 10
+    assert sum(step_reader.volume(s) for s in solids) == pytest.approx(expected, rel=1e-9)
+
+
+def test_check_counts_the_separate_pieces_of_a_visual_mesh():
+    """The check's own count (from the STL, vertices merged by position): pieces that share
+    a face read as one, a piece apart as another."""
+    from simkit.check.step import _pieces
+    from simkit.kitio.stl import from_stl, to_stl
+
+    foot = mf.Manifold.cube((0.12, 0.08, 0.02), center=True).translate((0.06, 0, 0.01))
+    wall = mf.Manifold.cube((0.02, 0.08, 0.10), center=True).translate((0.01, 0, 0.07))
+    bolt = mf.Manifold.cube((0.01, 0.01, 0.01), center=True).translate((0.3, 0, 0))
+    assert _pieces(from_stl(to_stl(to_mesh(foot + wall), "t")).faces) == 1
+    assert _pieces(from_stl(to_stl(to_mesh(foot + wall + bolt), "t")).faces) == 2
 
 
 def test_canonical_tail_ignores_the_writers_colour_order():

@@ -2,10 +2,12 @@
 solid with its visual STL.
 
 Read with STEPCAFControl_Reader: AP214 schema, millimetres, one assembly component per link
-with geometry, named as the link, each one solid that passes BRepCheck_Analyzer. Each solid's
-volume must be within 1 % of the visual STL's (the STL is the same solid tessellated with a
-fixed number of segments, so it holds slightly less) and its bounding box within 1 mm of the
-STL's, both in the assembly origin frame at the zero pose. The STLs are in link frames: FK
+with geometry, named as the link, holding a solid for each separate piece of the link's
+visual mesh (one for a primitive link; a CAD mesh of disjoint parts has several; pieces
+that only touch read as one piece from the STL but stay separate solids, hence "at least"),
+every solid passing BRepCheck_Analyzer. Each link's volume must be within 1 % of the visual
+STL's (the STL is the same solid tessellated with a fixed number of segments, so it holds
+slightly less) and its bounding box within 1 mm of the STL's, both in the assembly origin frame at the zero pose. The STLs are in link frames: FK
 from robot.json's own joints (q = 0) places them, so a moved or missing link fails.
 """
 
@@ -121,14 +123,29 @@ def _mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
 
 
-def _stl_in_origin(kit: Kit, path: str, pose: np.ndarray) -> tuple[float, np.ndarray]:
-    """Volume (mm^3) and bounds (mm) of a visual STL placed at `pose` (T_origin_link, m)."""
+def _pieces(faces: np.ndarray) -> int:
+    """Separate closed pieces of a triangle mesh: its vertex-connected components."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = int(faces.max()) + 1
+    a = np.concatenate([faces[:, 0], faces[:, 1]])
+    b = np.concatenate([faces[:, 1], faces[:, 2]])
+    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n))
+    used = np.unique(faces)
+    _, labels = connected_components(graph, directed=False)
+    return len(np.unique(labels[used]))
+
+
+def _visual(kit: Kit, path: str, pose: np.ndarray) -> tuple[float, np.ndarray, int]:
+    """Volume (mm^3), bounds (mm) and number of separate pieces of a visual STL placed at
+    `pose` (T_origin_link, m)."""
     from simkit.kitio.stl import from_stl
 
     mesh = from_stl(kit.path(path).read_bytes())
     points = (mesh.vertices @ pose[:3, :3].T + pose[:3, 3]) * 1000.0
     box = np.array([points.min(axis=0), points.max(axis=0)])
-    return _mesh_volume(mesh.vertices, mesh.faces) * 1e9, box
+    return _mesh_volume(mesh.vertices, mesh.faces) * 1e9, box, _pieces(mesh.faces)
 
 
 def check_step(kit: Kit) -> list[Finding]:
@@ -148,12 +165,19 @@ def check_step(kit: Kit) -> list[Finding]:
     from OCP.BRepCheck import BRepCheck_Analyzer
 
     parts, text = read_step(kit.path(entry["file"]))
-    meshes = {link["name"]: link["mesh"]["visual"] for link in kit.doc["links"]}
-    expected = sorted(name for name, path in meshes.items() if path)
     poses = zero_pose_frames(kit.doc, entry["origin"])
+    visuals = {
+        link["name"]: _visual(kit, link["mesh"]["visual"], poses[link["name"]])
+        for link in kit.doc["links"]
+        if link["mesh"]["visual"]
+    }
     counts = {name: len(solids) for name, solids in parts.items()}
-    wrong = [f"{n}: {counts.get(n, 0)} solids" for n in expected if counts.get(n, 0) != 1]
-    wrong += [f"{n}: not a link with geometry" for n in sorted(set(counts) - set(expected))]
+    wrong = [
+        f"{n}: {counts.get(n, 0)} solids for {pieces} pieces"
+        for n, (_v, _b, pieces) in sorted(visuals.items())
+        if counts.get(n, 0) < max(pieces, 1)
+    ]
+    wrong += [f"{n}: not a link with geometry" for n in sorted(set(counts) - set(visuals))]
     findings = [
         require(
             "step.schema",
@@ -163,7 +187,8 @@ def check_step(kit: Kit) -> list[Finding]:
         require(
             "step.products",
             not wrong,
-            f"one solid per link with geometry, named as the link ({len(expected)} links; "
+            f"one product per link with geometry, named as the link, with a solid for each "
+            f"separate piece of its visual mesh ({len(visuals)} links; "
             f"wrong: {', '.join(wrong) or 'none'})",
         ),
     ]
@@ -175,20 +200,21 @@ def check_step(kit: Kit) -> list[Finding]:
     findings.append(
         require("step.brepcheck", not invalid, f"every solid passes BRepCheck ({invalid or 'all'})")
     )
-    return findings + _against_meshes(kit, parts, meshes, poses, entry["origin"])
+    return findings + _against_meshes(parts, visuals, entry["origin"])
 
 
-def _against_meshes(kit: Kit, parts: dict, meshes: dict, poses: dict, origin: str) -> list:
-    """Volume and bounding box of each link's solid against its visual STL (mm)."""
+def _against_meshes(parts: dict, visuals: dict, origin: str) -> list:
+    """Volume and bounding box of each link's solids against its visual STL (mm)."""
     from simkit.check.readers.step import bounds, volume
 
     worst_volume, worst_bounds, off_volume, off_bounds = 0.0, 0.0, [], []
-    for name, path in sorted(meshes.items()):
-        if not path or len(parts.get(name, [])) != 1:
+    for name, (ref_volume, ref_box, _pieces) in sorted(visuals.items()):
+        if not parts.get(name):
             continue  # step.products reports it
-        ref_volume, ref_box = _stl_in_origin(kit, path, poses[name])
-        dv = abs(volume(parts[name][0]) / ref_volume - 1.0)
-        db = float(np.abs(bounds(parts[name][0]) - ref_box).max())
+        boxes = np.array([bounds(solid) for solid in parts[name]])
+        box = np.array([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+        dv = abs(sum(volume(solid) for solid in parts[name]) / ref_volume - 1.0)
+        db = float(np.abs(box - ref_box).max())
         worst_volume, worst_bounds = max(worst_volume, dv), max(worst_bounds, db)
         off_volume += [name] if dv > VOLUME_TOL else []
         off_bounds += [name] if db > BOUNDS_TOL else []
@@ -196,13 +222,13 @@ def _against_meshes(kit: Kit, parts: dict, meshes: dict, poses: dict, origin: st
         require(
             "step.volume",
             not off_volume,
-            f"each solid's volume within {VOLUME_TOL:.0%} of its visual STL's "
+            f"each link's solids' volume within {VOLUME_TOL:.0%} of its visual STL's "
             f"(worst {worst_volume:.3%}; off: {', '.join(off_volume) or 'none'})",
         ),
         require(
             "step.bounds",
             not off_bounds,
-            f"each solid's bounding box within {BOUNDS_TOL:g} mm of its visual STL's in "
+            f"each link's bounding box within {BOUNDS_TOL:g} mm of its visual STL's in "
             f"{origin} at the zero pose (worst {worst_bounds:.3g} mm; off: "
             f"{', '.join(off_bounds) or 'none'})",
         ),
