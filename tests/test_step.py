@@ -95,19 +95,6 @@ def test_mesh_link_pieces_are_separate_valid_solids_without_a_fuse():
     assert sum(step_reader.volume(s) for s in solids) == pytest.approx(expected, rel=1e-9)
 
 
-def test_check_counts_the_separate_pieces_of_a_visual_mesh():
-    """The check's own count (from the STL, vertices merged by position): pieces that share
-    a face read as one, a piece apart as another."""
-    from simkit.check.step import _pieces
-    from simkit.kitio.stl import from_stl, to_stl
-
-    foot = mf.Manifold.cube((0.12, 0.08, 0.02), center=True).translate((0.06, 0, 0.01))
-    wall = mf.Manifold.cube((0.02, 0.08, 0.10), center=True).translate((0.01, 0, 0.07))
-    bolt = mf.Manifold.cube((0.01, 0.01, 0.01), center=True).translate((0.3, 0, 0))
-    assert _pieces(from_stl(to_stl(to_mesh(foot + wall), "t")).faces) == 1
-    assert _pieces(from_stl(to_stl(to_mesh(foot + wall + bolt), "t")).faces) == 2
-
-
 def test_canonical_tail_ignores_the_writers_colour_order():
     head = "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1 = PRODUCT('a');\n#2 = PRODUCT('b');\n"
     a = (

@@ -1,14 +1,15 @@
 """Check of `step/NAME.step` (issue 14): re-read it with Open CASCADE and compare each link's
-solid with its visual STL.
+solids with its visual STL.
 
 Read with STEPCAFControl_Reader: AP214 schema, millimetres, one assembly component per link
-with geometry, named as the link, holding a solid for each separate piece of the link's
-visual mesh (one for a primitive link; a CAD mesh of disjoint parts has several; pieces
-that only touch read as one piece from the STL but stay separate solids, hence "at least"),
-every solid passing BRepCheck_Analyzer. Each link's volume must be within 1 % of the visual
-STL's (the STL is the same solid tessellated with a fixed number of segments, so it holds
-slightly less) and its bounding box within 1 mm of the STL's, both in the assembly origin frame at the zero pose. The STLs are in link frames: FK
-from robot.json's own joints (q = 0) places them, so a moved or missing link fails.
+with geometry, named as the link, holding the link's solids (one for a primitive link, whose
+touching primitives Open CASCADE fuses; one per separate piece for a mesh link: a CAD part
+with disjoint bolts has several), every solid passing BRepCheck_Analyzer. Each link's volume
+must be within 1 % of the visual STL's (the STL is the same solid tessellated with a fixed
+number of segments, so it holds slightly less; a removed or added piece shows here) and its
+bounding box within 1 mm of the STL's, both in the assembly origin frame at the zero pose.
+The STLs are in link frames: FK from robot.json's own joints (q = 0) places them, so a moved
+or missing link fails.
 """
 
 from __future__ import annotations
@@ -123,29 +124,14 @@ def _mesh_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
 
 
-def _pieces(faces: np.ndarray) -> int:
-    """Separate closed pieces of a triangle mesh: its vertex-connected components."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n = int(faces.max()) + 1
-    a = np.concatenate([faces[:, 0], faces[:, 1]])
-    b = np.concatenate([faces[:, 1], faces[:, 2]])
-    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n))
-    used = np.unique(faces)
-    _, labels = connected_components(graph, directed=False)
-    return len(np.unique(labels[used]))
-
-
-def _visual(kit: Kit, path: str, pose: np.ndarray) -> tuple[float, np.ndarray, int]:
-    """Volume (mm^3), bounds (mm) and number of separate pieces of a visual STL placed at
-    `pose` (T_origin_link, m)."""
+def _visual(kit: Kit, path: str, pose: np.ndarray) -> tuple[float, np.ndarray]:
+    """Volume (mm^3) and bounds (mm) of a visual STL placed at `pose` (T_origin_link, m)."""
     from simkit.kitio.stl import from_stl
 
     mesh = from_stl(kit.path(path).read_bytes())
     points = (mesh.vertices @ pose[:3, :3].T + pose[:3, 3]) * 1000.0
     box = np.array([points.min(axis=0), points.max(axis=0)])
-    return _mesh_volume(mesh.vertices, mesh.faces) * 1e9, box, _pieces(mesh.faces)
+    return _mesh_volume(mesh.vertices, mesh.faces) * 1e9, box
 
 
 def check_step(kit: Kit) -> list[Finding]:
@@ -172,11 +158,7 @@ def check_step(kit: Kit) -> list[Finding]:
         if link["mesh"]["visual"]
     }
     counts = {name: len(solids) for name, solids in parts.items()}
-    wrong = [
-        f"{n}: {counts.get(n, 0)} solids for {pieces} pieces"
-        for n, (_v, _b, pieces) in sorted(visuals.items())
-        if counts.get(n, 0) < max(pieces, 1)
-    ]
+    wrong = [f"{n}: no solid" for n in sorted(visuals) if not counts.get(n)]
     wrong += [f"{n}: not a link with geometry" for n in sorted(set(counts) - set(visuals))]
     findings = [
         require(
@@ -187,9 +169,8 @@ def check_step(kit: Kit) -> list[Finding]:
         require(
             "step.products",
             not wrong,
-            f"one product per link with geometry, named as the link, with a solid for each "
-            f"separate piece of its visual mesh ({len(visuals)} links; "
-            f"wrong: {', '.join(wrong) or 'none'})",
+            f"one product per link with geometry, named as the link, holding its solids "
+            f"({len(visuals)} links; wrong: {', '.join(wrong) or 'none'})",
         ),
     ]
     invalid = [
@@ -208,7 +189,7 @@ def _against_meshes(parts: dict, visuals: dict, origin: str) -> list:
     from simkit.check.readers.step import bounds, volume
 
     worst_volume, worst_bounds, off_volume, off_bounds = 0.0, 0.0, [], []
-    for name, (ref_volume, ref_box, _pieces) in sorted(visuals.items()):
+    for name, (ref_volume, ref_box) in sorted(visuals.items()):
         if not parts.get(name):
             continue  # step.products reports it
         boxes = np.array([bounds(solid) for solid in parts[name]])
