@@ -182,3 +182,32 @@ def test_imported_arm_builds(tmp_path, kit_factory):
     done = import_robot(ARM, tmp_path)
     result = kit_factory(str(done.spec_path))
     assert result.kit_dir.is_dir()
+
+
+def test_large_cad_meshes_leave_the_step_out(tmp_path, monkeypatch):
+    """Over the triangle budget the spec says `step: false`, with one report line."""
+    from simkit.importer import step_budget
+
+    small = import_robot(ARM, tmp_path / "a")
+    assert load_spec(small.spec_path)[0].step is True
+    data = yaml.safe_load(small.spec_path.read_text())
+    count = step_budget.visual_triangles(data, small.spec_path.parent)
+    assert count > 0
+    monkeypatch.setattr(step_budget, "MAX_TRIANGLES", count - 1)
+    big = import_robot(ARM, tmp_path / "b")
+    assert load_spec(big.spec_path)[0].step is False
+    assert [line for line in big.lines if f"{count:,} triangles" in line]
+
+
+@pytest.mark.slow
+def test_spec_step_false_builds_without_step(tmp_path):
+    import json
+
+    from simkit.pipeline import build
+
+    spec = tmp_path / "planar_2r.yaml"
+    text = (URDF.parent / "planar_2r.yaml").read_text()
+    spec.write_text(text + "\nstep: false\n")
+    result = build(str(spec), tmp_path / "out")
+    assert not any(path.startswith("step/") for path in result.files)
+    assert json.loads(result.files["robot.json"])["geometry"]["step"] is None

@@ -208,6 +208,7 @@ def build(
     say = progress or (lambda _msg: None)
     cache = Cache.at() if cache is None else cache
     robot = model_from_spec(target, progress, cache, jobs)
+    step = step and robot.step  # the spec can leave the STEP out too
     say("emit")
     files = emit_cached(robot, usd_format, cache, step)
     kit_name = layout.kit_dir_name(robot.name)

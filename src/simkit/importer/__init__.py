@@ -48,6 +48,16 @@ def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
     return text
 
 
+def _step_budget(spec: dict, stage: Path, report: Report, doc) -> None:
+    """`step: false` (reported) when the visual meshes are too large for a faceted STEP."""
+    from simkit.importer.step_budget import step_fits
+
+    fits, why = step_fits(spec, stage)
+    if not fits:
+        spec["step"] = False
+        report.changed(doc, doc.root, why)
+
+
 def robot_name(path: Path) -> str:
     """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
     stem = path.name.split(".")[0].lower()
@@ -83,6 +93,7 @@ def import_robot(
             first = report.problems[0]
             first.more = len(report.problems) - 1
             raise SpecError(first.file, first.line, first.field, first.message, first.more)
+        _step_budget(spec, stage, report, doc)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
         if floating:

@@ -213,6 +213,7 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         spec_file=spec_file,
         planning_groups=tuple(PlanningGroup(g.name, g.base, g.tip) for g in spec.planning_groups),
         asset_dir=spec.asset_dir,
+        step=spec.step,
         mjcf=spec.mjcf,
         ros2_control=spec.ros2_control,
         freefall=spec.freefall,

@@ -267,6 +267,8 @@ class Robot:
     #: MuJoCo scene settings (`spec_mjcf.MjcfSpec`, frozen), or None for simkit's defaults.
     mjcf: MjcfSpec | None = None
     asset_dir: str | None = None
+    #: whether the kit has `step/NAME.step` (spec `step`; `--no-step` overrides)
+    step: bool = True
     #: Gazebo / ros2_control additions and the free-fall validation (frozen spec sections)
     ros2_control: Ros2ControlSpec | None = None
     freefall: FreefallSpec | None = None

@@ -1,0 +1,41 @@
+"""Whether an imported robot's kit gets a STEP assembly: its visual CAD meshes must fit.
+
+A link from a mesh file becomes a faceted solid in the STEP: one planar face, its loop,
+edges, plane and points per triangle, about 2.3 kB of STEP text per triangle (measured with
+Open CASCADE 7.8 on a Centauro knee: 3,478 triangles, 8.2 MB). A robot with 337,000 visual
+triangles would get a 790 MB STEP that takes minutes to write and re-check, over the kit's
+64 MiB per-file cap. Above `MAX_TRIANGLES` the importer writes `step: false` in the spec and
+says so on one line; the user can set it back to true.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+#: Visual mesh triangles a kit's STEP can hold: about 46 MB of faceted STEP.
+MAX_TRIANGLES = 20_000
+
+
+def visual_triangles(spec: dict, spec_dir: Path) -> int:
+    """Triangles in the binary STLs the spec's link solids use (each file counted per use)."""
+    total = 0
+    for link in spec.get("links", []):
+        for shape in link.get("solid", []):
+            if shape.get("shape") == "mesh":
+                header = (spec_dir / shape["file"]).read_bytes()[80:84]
+                total += int(np.frombuffer(header, dtype="<u4")[0])
+    return total
+
+
+def step_fits(spec: dict, spec_dir: Path) -> tuple[bool, str]:
+    """(whether to write the STEP, the report line saying why not)."""
+    count = visual_triangles(spec, spec_dir)
+    if count <= MAX_TRIANGLES:
+        return True, ""
+    megabytes = count * 2.3e3 / 1e6
+    return False, (
+        f"no STEP assembly (spec step: false): the visual meshes hold {count:,} triangles, a "
+        f"faceted STEP of about {megabytes:,.0f} MB (limit {MAX_TRIANGLES:,} triangles)"
+    )
