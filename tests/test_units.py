@@ -115,3 +115,20 @@ def test_resolve_converts_degrees_and_orders_joints():
     assert robot.joint("j2").lower == pytest.approx(-math.pi / 4)
     assert robot.joint("j1").upper == 3.0
     assert robot.pose("home") == pytest.approx((math.pi / 2, 0.0))
+
+
+def test_canonical_faces_ignores_the_starting_corner_and_order():
+    """A hull listed from other corners, in another order, is one mesh (one cache key)."""
+    import numpy as np
+
+    from simkit.derive.per_link import canonical_faces
+    from simkit.kitio.cache import digest
+    from simkit.model.robot import Mesh
+
+    vertices = np.eye(4, 3)
+    faces = np.array([[0, 1, 2], [0, 3, 1], [1, 3, 2], [0, 2, 3]])
+    shuffled = np.array([[3, 1, 0], [2, 0, 1], [2, 3, 0], [1, 3, 2]])  # same triangles, same winding
+    a = canonical_faces(Mesh.of(vertices, faces))
+    b = canonical_faces(Mesh.of(vertices, shuffled))
+    assert digest(a) == digest(b)
+    assert sorted(map(tuple, a.faces)) == sorted(map(tuple, faces))

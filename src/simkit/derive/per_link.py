@@ -99,7 +99,20 @@ def _shape_hull(shape: Shape, base_dir: Path) -> Mesh:
         raise SpecError(str(base_dir), None, "collision_shapes.file", f"not found: {shape.file}")
     points = from_stl(path.read_bytes()).vertices * shape.scale
     points = points @ rpy_matrix(shape.rpy).T + np.asarray(shape.xyz)
-    return to_mesh(mf.Manifold.hull_points(np.asarray(points, np.float64)))
+    return canonical_faces(to_mesh(mf.Manifold.hull_points(np.asarray(points, np.float64))))
+
+
+def canonical_faces(mesh: Mesh) -> Mesh:
+    """The same mesh with each triangle started at its lowest vertex index (winding kept) and
+    the triangles sorted. manifold3d's hull of the same points can list its triangles from a
+    different corner from one call to the next, which changed the cache key of every later
+    step (the first rebuild of an imported robot missed) and the collision STL bytes."""
+    faces = np.asarray(mesh.faces)
+    if not len(faces):
+        return mesh
+    start = np.argmin(faces, axis=1)
+    rolled = np.stack([np.roll(row, -s) for row, s in zip(faces, start, strict=True)])
+    return Mesh.of(mesh.vertices, rolled[np.lexsort(rolled.T[::-1])])
 
 
 # --- collision --------------------------------------------------------------------------
