@@ -127,9 +127,7 @@ def test_canonical_faces_ignores_the_starting_corner_and_order():
 
     vertices = np.eye(4, 3)
     faces = np.array([[0, 1, 2], [0, 3, 1], [1, 3, 2], [0, 2, 3]])
-    shuffled = np.array(
-        [[3, 1, 0], [2, 0, 1], [2, 3, 0], [1, 3, 2]]
-    )  # same triangles
+    shuffled = np.array([[3, 1, 0], [2, 0, 1], [2, 3, 0], [1, 3, 2]])  # same triangles
     a = canonical_faces(Mesh.of(vertices, faces))
     b = canonical_faces(Mesh.of(vertices, shuffled))
     assert digest(a) == digest(b)
