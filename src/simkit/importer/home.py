@@ -23,7 +23,7 @@ import numpy as np
 #: pieces are grown a little to cover the visual mesh)
 CLEARANCE = 0.003
 GRID = 8  # range divisions tried per joint
-SWEEPS = 3
+SWEEPS = 3  # moves per joint at most
 
 
 def _text(values) -> str:
@@ -84,7 +84,7 @@ def _model_xml(robot, base_dir: Path) -> str:
     root = ET.Element("mujoco")
     ET.SubElement(root, "compiler", angle="radian")
     ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable")
-    margin = _text([CLEARANCE])
+    margin = _text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
     ET.SubElement(
         ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
     )
@@ -109,19 +109,45 @@ def _model_xml(robot, base_dir: Path) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def _penetration(model, data, adr, q) -> float:
-    """Sum over contacts of how far each pair is inside the clearance (m)."""
+def _penetration(model, data, adr, q) -> tuple[float, set[tuple[str, str]]]:
+    """How far (m, summed over contacts) links are inside the clearance, and the link pairs."""
     import mujoco
 
     data.qpos[adr] = q
     mujoco.mj_kinematics(model, data)
     mujoco.mj_collision(model, data)
-    return float(sum(CLEARANCE - d for d in data.contact.dist[: data.ncon]))
+    depth, pairs = 0.0, set()
+    for i in range(data.ncon):
+        if data.contact.dist[i] < CLEARANCE:
+            depth += CLEARANCE - float(data.contact.dist[i])
+            g1, g2 = data.contact.geom[i]
+            pairs.add(
+                (model.body(model.geom_bodyid[g1]).name, model.body(model.geom_bodyid[g2]).name)
+            )
+    return depth, pairs
+
+
+def _between(robot, a: str, b: str) -> list:
+    """The movable joints on the tree path between links `a` and `b`, distal first."""
+    parent = {j.child: j for j in robot.joints}
+
+    def up(node: str) -> list:
+        out = []
+        while node in parent:
+            out.append(parent[node])
+            node = parent[node].parent
+        return out
+
+    ua, ub = up(a), up(b)
+    common = {j.name for j in ua} & {j.name for j in ub}
+    return [j for j in ua + ub if j.name not in common and j.movable and j.mimic is None]
 
 
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
-    """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b
-    rad`), or None when the spec's home is already free or no grid pose is."""
+    """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
+    or None when the spec's home is already free or the search finds no free pose. Only the
+    joints between two links in contact move, each to the grid value that leaves the least
+    penetration, the one nearest the first guess on a tie."""
     import mujoco
     import yaml
 
@@ -134,7 +160,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     data = mujoco.MjData(model)
     movable = robot.movable_joints
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
-    q = np.array(dict(robot.poses)["home"], dtype=float)
+    start = np.array(dict(robot.poses)["home"], dtype=float)
     index = {j.name: i for i, j in enumerate(movable)}
 
     def follow(q: np.ndarray) -> np.ndarray:  # mimic joints follow their leaders
@@ -144,27 +170,25 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                 q[index[j.name]] = multiplier * q[index[leader]] + offset
         return q
 
-    best = _penetration(model, data, adr, q)
+    q = start.copy()
+    best, pairs = _penetration(model, data, adr, q)
     if best == 0.0:
         return None
-    start = q.copy()
-    for _ in range(SWEEPS):
-        for j in reversed(movable):  # the distal joints fold the robot onto itself first
-            if j.mimic is not None:
-                continue
+    for _ in range(SWEEPS * len(movable)):
+        joints = {j.name: j for a, b in sorted(pairs) for j in _between(robot, a, b)}
+        moved = False
+        for j in joints.values():
             lo, hi = (j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi)
             i = index[j.name]
             grid = np.linspace(lo, hi, GRID + 1)[1:-1]  # not at a limit, where a servo rests
             for value in sorted(grid, key=lambda v: abs(v - start[i])):
-                trial = q.copy()
-                trial[i] = value
-                trial = follow(trial)
-                depth = _penetration(model, data, adr, trial)
+                trial = follow(np.where(np.arange(len(q)) == i, value, q))
+                depth, found = _penetration(model, data, adr, trial)
                 if depth < best - 1e-9:
-                    q, best = trial, depth
-            if best == 0.0:
+                    q, best, pairs, moved = trial, depth, found, True
+            if moved:
                 break
-        if best == 0.0:
+        if best == 0.0 or not moved:
             break
     if best > 0.0:
         return None

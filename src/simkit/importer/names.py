@@ -56,6 +56,7 @@ def _construct(spec: dict) -> dict:
 def make_legal(spec: dict, source: Source, report: Report) -> None:
     """Rename (in place, with every reference) the links, joints and frames whose names the
     spec refuses; one `changed` line each at the URDF element."""
+    original: dict[str, str] = {}  # a renamed name -> the URDF's
     for _ in range(ROUNDS):
         bad = _problems(spec)
         if not bad:
@@ -73,8 +74,9 @@ def make_legal(spec: dict, source: Source, report: Report) -> None:
                 new, count = f"{base}{count}", count + 1
             taken.add(new.lower())
             renames.setdefault(key, {})[old] = new
+            original[new] = urdf = original.get(old, old)
             tag = "joint" if key == "joints" else "link"
-            element = next((e for e in source.root.iter(tag) if e.get("name") == old), None)
+            element = next((e for e in source.root.iter(tag) if e.get("name") == urdf), None)
             report.changed(source, element, f"renamed to '{new}' ({why})")
         _apply(spec, renames)
 
