@@ -148,21 +148,46 @@ def test_convexity_measure_sees_a_fold_and_convex_mesh_keeps_a_convex_piece():
     assert abs(_dent(dented, folded) - 0.001) < 1e-9
 
 
-def test_fk_reference_uses_the_numbers_the_kit_writes():
-    """Origins rounded to robot.json's digits: the reference is the pose those give."""
-    from dataclasses import dataclass
+def test_fk_reference_tolerance_is_the_written_numbers_precision(tmp_path):
+    """Eight origins turned by pi, written with ten digits: their FK differs from the exact
+    one by more than 1e-9 but within the rounding bound; a real error of 1e-6 still fails."""
+    import json
+    import math
 
-    from simkit.derive.references import _as_written
-    from simkit.model.robot import Frame, Joint
+    from simkit.check.kit import Kit
+    from simkit.check.published_numbers import check_published
+    from simkit.kitio.fmt import rounded
+    from simkit.model.kinematics import axis_angle, rpy_matrix, transform
 
-    @dataclass(frozen=True)
-    class Stub:  # the two fields `_as_written` replaces
-        joints: tuple
-        frames: tuple
+    rpy = [math.pi / 2, math.pi, -math.pi / 2]
+    joints = [
+        {
+            "name": f"j{i}",
+            "type": "revolute",
+            "parent": f"l{i}",
+            "child": f"l{i + 1}",
+            "origin_xyz": [0.1, 0.0, 0.05],
+            "origin_rpy": [rounded(v) for v in rpy],
+            "axis": [0.0, 0.0, 1.0],
+        }
+        for i in range(8)
+    ]
+    q = [1.0] * 8
+    exact = np.eye(4)
+    for value in q:  # the pose the spec's exact numbers give
+        exact = exact @ transform([0.1, 0.0, 0.05], rpy_matrix(rpy))
+        exact = exact @ transform((0, 0, 0), axis_angle([0, 0, 1], value))
+    doc = {"name": "r", "joints": joints, "fixed_joints": [], "links": [], "frames": {},
+           "files": {}, "base_frame": "l0", "tool_frame": "l8"}  # fmt: skip
 
-    joint = Joint("j", "revolute", "a", "b", (0.1, 0.0, 0.0), (3.14159265359, 0.0, 0.0), (0, 0, 1))
-    frame = Frame("f", "b", (0.123456789012, 0.0, 0.0), (0.0, 0.0, 0.0))
-    out = _as_written(Stub((joint,), (frame,)))
-    assert out.joints[0].rpy == (3.141592654, 0.0, 0.0)
-    assert out.frames[0].xyz == (0.123456789, 0.0, 0.0)
-    assert out.joints[0].xyz == joint.xyz and out.joints[0].axis == joint.axis
+    def findings(rotation: np.ndarray) -> dict:
+        ref = {"pose": "home", "q": q, "l8": {"xyz": list(exact[:3, 3]), "rotation": rotation}}
+        (tmp_path / "robot.json").write_text(json.dumps({**doc, "fk_reference": [ref]}))
+        return {f.check: f.ok for f in check_published(Kit(tmp_path))}
+
+    written = Kit(tmp_path)
+    (tmp_path / "robot.json").write_text(json.dumps(doc))
+    error = np.abs(written.fk(q)[:3, :3] - exact[:3, :3]).max()
+    assert error > 1e-9  # a fixed 1e-9 refuses a kit whose numbers are right
+    assert all(findings(exact[:3, :3].tolist()).values())
+    assert not findings((exact[:3, :3] + 1e-6).tolist())["fk_reference.home.rotation"]

@@ -8,23 +8,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from simkit.kitio.fmt import rounded
 from simkit.model.kinematics import forward
 from simkit.model.robot import Robot
-
-
-def _as_written(robot: Robot) -> Robot:
-    """The robot with its joint and frame origins and axes as robot.json writes them (`fmt`'s
-    significant digits), so the FK reference is the pose the kit's own numbers give: an
-    origin angle near pi loses up to 5e-10 rad to the rounding, and seven joints of such
-    angles move the tool by more than the reference check's 1e-9 (Kinova's URDF)."""
-
-    def r(values) -> tuple[float, ...]:
-        return tuple(rounded(v) for v in values)
-
-    joints = tuple(replace(j, xyz=r(j.xyz), rpy=r(j.rpy), axis=r(j.axis)) for j in robot.joints)
-    frames = tuple(replace(f, xyz=r(f.xyz), rpy=r(f.rpy)) for f in robot.frames)
-    return replace(robot, joints=joints, frames=frames)
 
 
 def _distance_from_axis(point: np.ndarray, origin: np.ndarray, axis: np.ndarray) -> float:
@@ -38,9 +23,8 @@ def derive_references(robot: Robot) -> Robot:
     base = movable[0].parent if movable else robot.root
     tool = robot.tool_frame
     fk_reference = []
-    written = _as_written(robot)
     for name, q in robot.poses:
-        poses = forward(written, [rounded(v) for v in q])
+        poses = forward(robot, q)
         inv = np.linalg.inv(poses[base])
         entry: dict = {"pose": name, "q": list(q)}
         if robot.wrist_centre:
