@@ -34,7 +34,7 @@ def rounding_bound(kit: Kit, q) -> tuple[float, float]:
         joint = by_child[node]
         value = abs(values.get(joint["name"], 0.0))
         angle += float(np.abs(joint["origin_rpy"]).sum())
-        if joint["type"] == "prismatic":
+        if joint.get("type") == "prismatic":  # fixed joints carry no type
             length += value * (1 + np.sqrt(3))
         else:
             angle += value * (1 + np.sqrt(3))

@@ -54,7 +54,8 @@ def _geom(asset, body, shape, base_dir: Path, name: str) -> None:
 
 
 def _shapes(link) -> tuple:
-    if link.collision_primitives:
+    """The shapes whose hulls stand for the link's collision geometry in the kit."""
+    if link.collision_method == "primitives":  # none when the URDF gives no collision
         return link.collision_primitives
     if link.collision_shapes:
         return link.collision_shapes
