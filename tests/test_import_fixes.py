@@ -177,11 +177,19 @@ def test_fk_reference_tolerance_is_the_written_numbers_precision(tmp_path):
     for value in q:  # the pose the spec's exact numbers give
         exact = exact @ transform([0.1, 0.0, 0.05], rpy_matrix(rpy))
         exact = exact @ transform((0, 0, 0), axis_angle([0, 0, 1], value))
-    doc = {"name": "r", "joints": joints, "fixed_joints": [], "links": [], "frames": {},
-           "files": {}, "base_frame": "l0", "tool_frame": "l8"}  # fmt: skip
+    exact = exact @ transform([0.0, 0.0, 0.1], np.eye(3))  # a fixed joint to the tool
+    tool = {
+        "name": "f",
+        "parent": "l8",
+        "child": "l9",
+        "origin_xyz": [0.0, 0.0, 0.1],
+        "origin_rpy": [0.0, 0.0, 0.0],
+    }  # fixed joints carry no type
+    doc = {"name": "r", "joints": joints, "fixed_joints": [tool], "links": [], "frames": {},
+           "files": {}, "base_frame": "l0", "tool_frame": "l9"}  # fmt: skip
 
     def findings(rotation: np.ndarray) -> dict:
-        ref = {"pose": "home", "q": q, "l8": {"xyz": list(exact[:3, 3]), "rotation": rotation}}
+        ref = {"pose": "home", "q": q, "l9": {"xyz": list(exact[:3, 3]), "rotation": rotation}}
         (tmp_path / "robot.json").write_text(json.dumps({**doc, "fk_reference": [ref]}))
         return {f.check: f.ok for f in check_published(Kit(tmp_path))}
 
