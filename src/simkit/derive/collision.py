@@ -116,6 +116,8 @@ def _mesh(solid) -> Mesh:
     return to_mesh(solid)
 
 
+#: matrix entries per block in `outside_depth` (8 MB of float64)
+CHUNK = 1 << 20
 #: m: how far a face of a hull may lie inside the exact convex hull of its vertices
 CONVEX_EPS = 1e-7
 
@@ -233,7 +235,16 @@ def _halfspaces(hull: Mesh) -> tuple[np.ndarray, np.ndarray]:
 def outside_depth(points: np.ndarray, hull: Mesh) -> np.ndarray:
     """How far each point lies outside a convex mesh (max face-plane distance; <= 0 inside)."""
     n, d = _halfspaces(hull)
-    return (points @ n.T - d).max(axis=1)
+    # in blocks of points: a detailed hull (SO-101's base, 9000 faces) against 100 000
+    # surface samples is a 7 GB matrix at once; the same maxima, block by block
+    rows = max(1, CHUNK // max(len(d), 1))
+    return (
+        np.concatenate(
+            [(points[i : i + rows] @ n.T - d).max(axis=1) for i in range(0, len(points), rows)]
+        )
+        if len(points)
+        else np.zeros(0)
+    )
 
 
 def cover(hulls: list, samples: np.ndarray) -> list:

@@ -104,10 +104,9 @@ def import_robot(
             raise SpecError(first.file, first.line, first.field, first.message, first.more)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
-        if floating:
+        _free_home(spec, report, doc, stage / f"{name}.yaml", path)
+        if floating:  # after the home pose is chosen: the robot stands on it
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
-        else:
-            _free_home(spec, report, doc, stage / f"{name}.yaml", path)
         writer.check(stage / f"{name}.yaml")
         for item in sorted(stage.rglob("*")):
             if item.is_file():

@@ -1,4 +1,4 @@
-"""A home pose free of self-contact for a fixed-base import.
+"""A home pose free of self-contact for an import (fixed or floating base).
 
 The importer's first guess at `home` is 0 for every joint (the middle of the range where 0
 is outside it). Many URDFs fold up at 0 (Panda's wrist, Z1's elbow, SO-100's jaw, PR2's arms
@@ -23,6 +23,8 @@ import numpy as np
 #: pieces are grown a little to cover the visual mesh)
 CLEARANCE = 0.003
 GRID = 8  # range divisions tried per joint
+#: rad or m: turns (slides) from the first guess tried before the grid
+STEPS = 0.05 * 2.0 ** np.arange(6)
 SWEEPS = 3  # moves per joint at most
 
 
@@ -181,7 +183,10 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
         for j in joints.values():
             lo, hi = (j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi)
             i = index[j.name]
-            grid = np.linspace(lo, hi, GRID + 1)[1:-1]  # not at a limit, where a servo rests
+            grid = np.concatenate(  # small turns first, then the range; never at a limit
+                [start[i] + STEPS, start[i] - STEPS, np.linspace(lo, hi, GRID + 1)[1:-1]]
+            )
+            grid = grid[(grid > lo + 1e-6) & (grid < hi - 1e-6)]
             for value in sorted(grid, key=lambda v: abs(v - start[i])):
                 trial = follow(np.where(np.arange(len(q)) == i, value, q))
                 depth, found = _penetration(model, data, adr, trial)
