@@ -199,3 +199,17 @@ def test_fk_reference_tolerance_is_the_written_numbers_precision(tmp_path):
     assert error > 1e-9  # a fixed 1e-9 refuses a kit whose numbers are right
     assert all(findings(exact[:3, :3].tolist()).values())
     assert not findings((exact[:3, :3] + 1e-6).tolist())["fk_reference.home.rotation"]
+
+
+def test_outside_depth_in_blocks_is_the_same_as_at_once(monkeypatch):
+    import manifold3d as mf
+
+    from simkit.derive import collision
+    from simkit.derive.solids import to_mesh
+
+    hull = to_mesh(mf.Manifold.sphere(0.1, 48))
+    points = np.random.default_rng(0).uniform(-0.2, 0.2, (1000, 3))
+    n, d = collision._halfspaces(hull)
+    whole = (points @ n.T - d).max(axis=1)
+    monkeypatch.setattr(collision, "CHUNK", 7 * len(d))  # 7 points a block
+    assert np.array_equal(collision.outside_depth(points, hull), whole)
