@@ -6,8 +6,9 @@ inside the base), so the kit's servos would hold a pose its own links penetrate.
 measures self-contact with MuJoCo on the links' collision geometry (primitives, the convex
 hull of each given collision mesh, else the hull of each visual piece; links joined by a
 joint, or by links without geometry, never collide, as in the kit) and, where the guess is
-in contact, moves one joint at a time to the value on a grid of its range that leaves the
-least penetration, until no two links are closer than `CLEARANCE`.
+in contact, moves the joints between touching links one at a time (small turns first, then
+a grid of the range) to the value that leaves the least intrusion into `CLEARANCE`, until
+none is left or no move helps. The new pose is kept when no two links touch in it.
 """
 
 from __future__ import annotations
@@ -130,6 +131,11 @@ def _penetration(model, data, adr, q) -> tuple[float, set[tuple[str, str]]]:
     return depth, pairs
 
 
+def _touching(data) -> bool:
+    """True when the last `_penetration` found two links touching or overlapping."""
+    return bool((data.contact.dist[: data.ncon] <= 0.0).any())
+
+
 def _between(robot, a: str, b: str) -> list:
     """The movable joints on the tree path between links `a` and `b`, distal first."""
     parent = {j.child: j for j in robot.joints}
@@ -175,7 +181,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
 
     q = start.copy()
     best, pairs = _penetration(model, data, adr, q)
-    if best == 0.0:
+    if not _touching(data):  # closer than the clearance is fine at the first guess
         return None
     for _ in range(SWEEPS * len(movable)):
         joints = {j.name: j for a, b in sorted(pairs) for j in _between(robot, a, b)}
@@ -196,7 +202,8 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                 break
         if best == 0.0 or not moved:
             break
-    if best > 0.0:
+    _penetration(model, data, adr, q)
+    if _touching(data):  # no free pose found: the first guess stays
         return None
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
