@@ -48,6 +48,13 @@ def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
     return text
 
 
+def robot_name(path: Path) -> str:
+    """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
+    stem = path.name.split(".")[0].lower()
+    name = re.sub(r"[^a-z0-9_]+", "_", stem).strip("_") or "robot"
+    return name if name[0].isalpha() else f"robot_{name}"
+
+
 def _free_home(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
     """Move `home` out of self-contact (home.py) and rewrite the spec, reporting the change."""
     from simkit.importer import home, writer
@@ -64,13 +71,6 @@ def _free_home(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> 
         + " rad or m",
     )
     spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
-
-
-def robot_name(path: Path) -> str:
-    """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
-    stem = path.name.split(".")[0].lower()
-    name = re.sub(r"[^a-z0-9_]+", "_", stem).strip("_") or "robot"
-    return name if name[0].isalpha() else f"robot_{name}"
 
 
 def import_robot(
