@@ -6,9 +6,42 @@ import numpy as np
 
 from simkit.check.findings import Finding, compare
 from simkit.check.kit import Kit
+from simkit.kitio.fmt import SIGNIFICANT_DIGITS
 
 LENGTH_TOL = 1e-4  # m: the published numbers must match to 0.1 mm
 MASS_TOL = 0.01  # kg
+FK_REF_TOL = 1e-9  # m and rotation-matrix entries, on top of the file's own rounding
+
+
+def rounding_bound(kit: Kit, q) -> tuple[float, float]:
+    """Bounds on how far the tool can move (m, rotation-matrix entries) because robot.json
+    writes every number with `fmt.SIGNIFICANT_DIGITS` digits: the FK reference is computed
+    from the spec's exact numbers, the check's FK from the written ones. Each written angle,
+    length or joint value is off by at most `eps` times its size, an axis component likewise
+    (a turn of at most sqrt(3) eps |q|). An origin angle near pi alone is off by 5e-10 rad,
+    so a chain of such origins (Kinova's URDF) exceeds a fixed 1e-9 with exact numbers."""
+    eps = 0.5 * 10.0 ** (1 - SIGNIFICANT_DIGITS)
+    values = dict(zip([j["name"] for j in kit.joints], q, strict=True))
+    by_child = {j["child"]: j for j in kit.joints + kit.doc["fixed_joints"]}
+    frame = kit.doc["frames"].get(kit.doc["tool_frame"]) or {}
+    node = kit.doc["tool_frame"]
+    angle = length = reach = 0.0
+    if node not in by_child and "parent" in frame:
+        angle += float(np.abs(frame["rpy"]).sum())
+        length += float(np.linalg.norm(frame["xyz"]))
+        node = frame["parent"]
+    while node != kit.base_frame:
+        joint = by_child[node]
+        value = abs(values.get(joint["name"], 0.0))
+        angle += float(np.abs(joint["origin_rpy"]).sum())
+        if joint.get("type") == "prismatic":  # fixed joints carry no type
+            length += value * (1 + np.sqrt(3))
+        else:
+            angle += value * (1 + np.sqrt(3))
+        length += float(np.linalg.norm(joint["origin_xyz"]))
+        node = joint["parent"]
+    reach = length
+    return eps * (length + angle * reach), eps * angle
 
 
 def check_published(kit: Kit) -> list[Finding]:
@@ -18,13 +51,14 @@ def check_published(kit: Kit) -> list[Finding]:
         if doc.get("tool_frame") in ref:
             actual = kit.fk(ref["q"])
             expected = ref[doc["tool_frame"]]
+            length, angle = rounding_bound(kit, ref["q"])
             findings.append(
                 compare(
                     f"fk_reference.{ref['pose']}",
                     "tool pose from robot.json joints",
                     expected["xyz"],
                     actual[:3, 3],
-                    1e-9,
+                    FK_REF_TOL + length,
                     "m",
                 )
             )
@@ -34,7 +68,7 @@ def check_published(kit: Kit) -> list[Finding]:
                     "tool rotation",
                     expected["rotation"],
                     actual[:3, :3],
-                    1e-9,
+                    FK_REF_TOL + angle,
                     "",
                 )
             )

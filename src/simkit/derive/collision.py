@@ -116,6 +116,38 @@ def _mesh(solid) -> Mesh:
     return to_mesh(solid)
 
 
+#: matrix entries per block in `outside_depth` (8 MB of float64)
+CHUNK = 1 << 20
+#: m: how far a face of a hull may lie inside the exact convex hull of its vertices
+CONVEX_EPS = 1e-7
+
+
+def convex_mesh(solid) -> Mesh:
+    """The mesh of a hull, exactly convex. manifold3d's hull of near-coplanar points (a piece
+    grown by `cover` to take in visual vertices just outside it) can fold faces inward by a
+    fraction of a millimetre (TIAGo's arm_1_link: 0.4 mm); such a mesh is replaced by qhull's
+    triangulated hull of the same vertices, faces turned outward. A convex mesh is kept as
+    it is (the same bytes as before)."""
+    from scipy.spatial import ConvexHull
+
+    mesh = _mesh(solid)
+    hull = ConvexHull(mesh.vertices)
+    planes = hull.equations
+    samples = np.vstack([mesh.vertices, mesh.vertices[mesh.faces].mean(axis=1)])
+    if -(samples @ planes[:, :3].T + planes[:, 3]).max(axis=1).min() <= CONVEX_EPS:
+        return mesh
+    keep = np.sort(hull.vertices)
+    index = np.full(len(mesh.vertices), -1, dtype=np.int64)
+    index[keep] = np.arange(len(keep))
+    faces = index[hull.simplices]
+    vertices = mesh.vertices[keep]
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    flip = np.einsum("ij,ij->i", normal, planes[:, :3]) < 0
+    faces[flip] = faces[flip][:, ::-1]
+    return Mesh.of(vertices, faces)
+
+
 # --- exact convex pieces -----------------------------------------------------------------
 
 
@@ -203,7 +235,16 @@ def _halfspaces(hull: Mesh) -> tuple[np.ndarray, np.ndarray]:
 def outside_depth(points: np.ndarray, hull: Mesh) -> np.ndarray:
     """How far each point lies outside a convex mesh (max face-plane distance; <= 0 inside)."""
     n, d = _halfspaces(hull)
-    return (points @ n.T - d).max(axis=1)
+    # in blocks of points: a detailed hull (SO-101's base, 9000 faces) against 100 000
+    # surface samples is a 7 GB matrix at once; the same maxima, block by block
+    rows = max(1, CHUNK // max(len(d), 1))
+    return (
+        np.concatenate(
+            [(points[i : i + rows] @ n.T - d).max(axis=1) for i in range(0, len(points), rows)]
+        )
+        if len(points)
+        else np.zeros(0)
+    )
 
 
 def cover(hulls: list, samples: np.ndarray) -> list:
@@ -349,7 +390,7 @@ def link_collision(link: Link, seed: int) -> tuple[tuple[Mesh, ...], dict]:
         )
     else:
         hulls = cover(run_coacd(link.solid, seed), surface_samples(link.solid))
-    meshes = [_mesh(h) for h in hulls]
+    meshes = [convex_mesh(h) for h in hulls]
     order = sorted(range(len(meshes)), key=lambda i: tuple(np.round(meshes[i].vertices.mean(0), 9)))
     hulls, meshes = [hulls[i] for i in order], [meshes[i] for i in order]
     report = {"method": method, **quality(link.solid, hulls)}

@@ -65,6 +65,24 @@ def robot_name(path: Path) -> str:
     return name if name[0].isalpha() else f"robot_{name}"
 
 
+def _free_home(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
+    """Move `home` out of self-contact (home.py) and rewrite the spec, reporting the change."""
+    from simkit.importer import home, writer
+
+    found = home.free_home(spec_path)
+    if found is None:
+        return
+    spec["poses"]["home"], changes = found
+    report.assumed(
+        doc,
+        doc.root,
+        "home: the links collide at the first guess (0, or mid-range outside the limits); "
+        + ", ".join(changes)
+        + " rad or m",
+    )
+    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
+
+
 def import_robot(
     path: Path,
     out_dir: Path,
@@ -77,7 +95,7 @@ def import_robot(
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `hull_collision`: links whose URDF collision has meshes collide with their visual
     solid's convex hull instead (one piece; reported per link)."""
-    from simkit.importer import convert, meshes, source, writer
+    from simkit.importer import convert, meshes, names, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
@@ -89,6 +107,7 @@ def import_robot(
         stage = Path(tmp)
         mesh_writer = meshes.MeshWriter(stage)
         spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
+        names.make_legal(spec, doc, report)
         if strict and report.problems:
             first = report.problems[0]
             first.more = len(report.problems) - 1
@@ -96,7 +115,8 @@ def import_robot(
         _step_budget(spec, stage, report, doc)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
-        if floating:
+        _free_home(spec, report, doc, stage / f"{name}.yaml", path)
+        if floating:  # after the home pose is chosen: the robot stands on it
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
         writer.check(stage / f"{name}.yaml")
         for item in sorted(stage.rglob("*")):

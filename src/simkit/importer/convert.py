@@ -162,7 +162,7 @@ def convert(
         spec["tool_frame"] = tool
     if colours:
         spec["materials"] = [{"name": n, "rgba": list(c)} for c, n in colours.items()]
-    spec_joints = _depth_first(spec_joints, spec_root)
+    spec_joints = _depth_first(spec_joints, spec_root, _ancestors(tool, spec_joints, spec_frames))
     _check_mimics(source, spec_joints, report)
     rank = {j["child"]: i for i, j in enumerate(spec_joints)}
     spec_links.sort(key=lambda link: rank.get(link["name"], -1))
@@ -197,12 +197,27 @@ def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
             )
 
 
-def _depth_first(joints: list[dict], root: str) -> list[dict]:
-    """Joints depth first from the root, siblings in document order (the spec's tree order,
-    which `poses` follow)."""
+def _ancestors(tool: str | None, joints: list[dict], frames: list[dict]) -> set[str]:
+    """The tool frame and every link above it."""
+    parent = {j["child"]: j["parent"] for j in joints}
+    parent.update({f["name"]: f["parent"] for f in frames})
+    out, node = set(), tool
+    while node is not None and node not in out:
+        out.add(node)
+        node = parent.get(node)
+    return out
+
+
+def _depth_first(joints: list[dict], root: str, first: set[str] = frozenset()) -> list[dict]:
+    """Joints depth first from the root, siblings in document order except that the branch
+    to the tool (`first`: the links above it) comes first, so the first movable joint is on
+    the tool's chain (the planning group and FK reference start at its parent). This is the
+    spec's tree order, which `poses` follow."""
     by_parent: dict[str, list[dict]] = {}
     for joint in joints:
         by_parent.setdefault(joint["parent"], []).append(joint)
+    for siblings in by_parent.values():
+        siblings.sort(key=lambda j: j["child"] not in first)  # stable: document order kept
     out: list[dict] = []
     stack = list(reversed(by_parent.get(root, [])))
     while stack:

@@ -10,9 +10,12 @@ from simkit.importer.geometry import floats, origin, shape_of
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
 from simkit.importer.source import Source
+from simkit.spec.bounds import FIELD_BOUNDS
 
 #: kg and kg m^2 given to a link the URDF leaves massless (MuJoCo needs mass on moving bodies)
 MASSLESS_MASS, MASSLESS_INERTIA = 0.001, 1.0e-7
+#: kg: the smallest mass a spec accepts; a URDF's smaller one is raised to it
+MIN_MASS = FIELD_BOUNDS["mass"][0]
 #: kg/m^3 of the solid sphere whose inertia replaces a zero one
 DENSITY = 1000.0
 KNOWN = {"inertial", "visual", "collision"}
@@ -74,6 +77,16 @@ def inertial(source: Source, link, report: Report) -> dict:
     keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
     flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
     out: dict = {"mass": mass, "com": list(xyz)}
+    if mass < MIN_MASS:  # a placeholder mass (1e-6 kg) is below what the spec accepts
+        tensor, mass = tensor * (MIN_MASS / mass), MIN_MASS
+        flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
+        report.estimated(
+            source,
+            element.find("mass"),
+            f"mass {out['mass']:g} kg is too small to simulate: {MIN_MASS:g} kg, inertia "
+            "scaled by the same factor (same radius of gyration)",
+        )
+        out.update(mass=mass, estimated=["mass", "inertia"])
     if np.trace(tensor) <= 1e-12 * max(mass, 1e-12):
         radius = (3 * mass / (4 * math.pi * DENSITY)) ** (1 / 3)
         moment = 0.4 * mass * radius * radius
@@ -83,7 +96,7 @@ def inertial(source: Source, link, report: Report) -> dict:
             f"zero inertia: a {DENSITY:g} kg/m^3 solid sphere of that mass ({moment:.3g} kg m^2)",
         )
         out["inertia"] = {"ixx": moment, "iyy": moment, "izz": moment}
-        out["estimated"] = ["inertia"]
+        out["estimated"] = sorted({*out.get("estimated", []), "inertia"})
         return out
     out["inertia"] = {k: float(round(v, 15)) for k, v in zip(keys, flat, strict=True)}
     problem = inertia_problem(InertiaSpec(**out["inertia"]))

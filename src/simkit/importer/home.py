@@ -1,0 +1,213 @@
+"""A home pose free of self-contact for an import (fixed or floating base).
+
+The importer's first guess at `home` is 0 for every joint (the middle of the range where 0
+is outside it). Many URDFs fold up at 0 (Panda's wrist, Z1's elbow, SO-100's jaw, PR2's arms
+inside the base), so the kit's servos would hold a pose its own links penetrate. This module
+measures self-contact with MuJoCo on the links' collision geometry (primitives, the convex
+hull of each given collision mesh, else the hull of each visual piece; links joined by a
+joint, or by links without geometry, never collide, as in the kit) and, where the guess is
+in contact, moves the joints between touching links one at a time (small turns first, then
+a grid of the range) to the value that leaves the least intrusion into `CLEARANCE`, until
+none is left or no move helps. The new pose is kept when no two links touch in it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+#: m: the clearance the chosen pose keeps between non-adjacent links (the kit's collision
+#: pieces are grown a little to cover the visual mesh)
+CLEARANCE = 0.003
+GRID = 8  # range divisions tried per joint
+#: rad or m: turns (slides) from the first guess tried before the grid
+STEPS = 0.05 * 2.0 ** np.arange(6)
+SWEEPS = 3  # moves per joint at most
+
+
+def _text(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+def _geom(asset, body, shape, base_dir: Path, name: str) -> None:
+    from simkit.kitio.stl import from_stl
+    from simkit.model.kinematics import quat_wxyz, rpy_matrix
+
+    attrs = {"pos": _text(shape.xyz), "quat": _text(quat_wxyz(rpy_matrix(shape.rpy)))}
+    if shape.kind == "mesh":
+        vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
+        ET.SubElement(asset, "mesh", name=name, vertex=_text(vertices))
+        attrs.update(type="mesh", mesh=name)
+    elif shape.kind == "box":
+        attrs.update(type="box", size=_text(np.asarray(shape.size) / 2))
+    elif shape.kind == "sphere":
+        attrs.update(type="sphere", size=_text([shape.radius]))
+    elif shape.kind in ("cylinder", "capsule"):
+        attrs.update(type=shape.kind, size=_text([shape.radius, shape.length / 2]))
+    else:  # a cone: its bounding cylinder
+        attrs.update(
+            type="cylinder",
+            size=_text([max(shape.radius, shape.radius_top or 0), shape.length / 2]),
+        )
+    ET.SubElement(body, "geom", attrs)
+
+
+def _shapes(link) -> tuple:
+    """The shapes whose hulls stand for the link's collision geometry in the kit."""
+    if link.collision_method == "primitives":  # none when the URDF gives no collision
+        return link.collision_primitives
+    if link.collision_shapes:
+        return link.collision_shapes
+    return link.shapes
+
+
+def _adjacent(robot) -> set[tuple[str, str]]:
+    """Links joined by a joint, or through links without geometry (the kit's exclusions)."""
+    near: dict[str, set[str]] = {}
+    for joint in robot.joints:
+        near.setdefault(joint.parent, set()).add(joint.child)
+        near.setdefault(joint.child, set()).add(joint.parent)
+    solid = {link.name for link in robot.links if _shapes(link)}
+    for node in sorted(set(near) - solid):
+        around = near.pop(node)
+        for other in around:
+            near[other].discard(node)
+        for a, b in itertools.combinations(sorted(around), 2):
+            near[a].add(b)
+            near[b].add(a)
+    return {tuple(sorted((a, b))) for a in solid for b in near.get(a, ()) if b in solid}
+
+
+def _model_xml(robot, base_dir: Path) -> str:
+    from simkit.model.kinematics import quat_wxyz, rpy_matrix
+
+    root = ET.Element("mujoco")
+    ET.SubElement(root, "compiler", angle="radian")
+    ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable")
+    margin = _text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
+    ET.SubElement(
+        ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
+    )
+    asset = ET.SubElement(root, "asset")
+    bodies = {robot.root: ET.SubElement(root, "worldbody")}
+    for joint in robot.joints:
+        link = robot.link(joint.child)
+        quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
+        body = ET.SubElement(
+            bodies[joint.parent], "body", name=link.name, pos=_text(joint.xyz), quat=quat
+        )
+        bodies[link.name] = body
+        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
+        if kind:
+            ET.SubElement(body, "joint", name=joint.name, type=kind, axis=_text(joint.axis))
+        for i, shape in enumerate(_shapes(link)):
+            _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+    contact = ET.SubElement(root, "contact")
+    for a, b in sorted(_adjacent(robot)):
+        ET.SubElement(contact, "exclude", body1=a, body2=b)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _penetration(model, data, adr, q) -> tuple[float, set[tuple[str, str]]]:
+    """How far (m, summed over contacts) links are inside the clearance, and the link pairs."""
+    import mujoco
+
+    data.qpos[adr] = q
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_collision(model, data)
+    depth, pairs = 0.0, set()
+    for i in range(data.ncon):
+        if data.contact.dist[i] < CLEARANCE:
+            depth += CLEARANCE - float(data.contact.dist[i])
+            g1, g2 = data.contact.geom[i]
+            pairs.add(
+                (model.body(model.geom_bodyid[g1]).name, model.body(model.geom_bodyid[g2]).name)
+            )
+    return depth, pairs
+
+
+def _touching(data) -> bool:
+    """True when the last `_penetration` found two links touching or overlapping."""
+    return bool((data.contact.dist[: data.ncon] <= 0.0).any())
+
+
+def _between(robot, a: str, b: str) -> list:
+    """The movable joints on the tree path between links `a` and `b`, distal first."""
+    parent = {j.child: j for j in robot.joints}
+
+    def up(node: str) -> list:
+        out = []
+        while node in parent:
+            out.append(parent[node])
+            node = parent[node].parent
+        return out
+
+    ua, ub = up(a), up(b)
+    common = {j.name for j in ua} & {j.name for j in ub}
+    return [j for j in ua + ub if j.name not in common and j.movable and j.mimic is None]
+
+
+def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
+    """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
+    or None when the spec's home is already free or the search finds no free pose. Only the
+    joints between two links in contact move, each to the grid value that leaves the least
+    penetration, the one nearest the first guess on a tie."""
+    import mujoco
+    import yaml
+
+    from simkit.model.resolve import resolve
+    from simkit.spec.schema import RobotSpec
+
+    text = spec_path.read_text(encoding="utf-8")
+    robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
+    model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent))
+    data = mujoco.MjData(model)
+    movable = robot.movable_joints
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    start = np.array(dict(robot.poses)["home"], dtype=float)
+    index = {j.name: i for i, j in enumerate(movable)}
+
+    def follow(q: np.ndarray) -> np.ndarray:  # mimic joints follow their leaders
+        for j in movable:
+            if j.mimic is not None and j.mimic[0] in index:
+                leader, multiplier, offset = j.mimic
+                q[index[j.name]] = multiplier * q[index[leader]] + offset
+        return q
+
+    q = start.copy()
+    best, pairs = _penetration(model, data, adr, q)
+    if not _touching(data):  # closer than the clearance is fine at the first guess
+        return None
+    for _ in range(SWEEPS * len(movable)):
+        joints = {j.name: j for a, b in sorted(pairs) for j in _between(robot, a, b)}
+        moved = False
+        for j in joints.values():
+            lo, hi = (j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi)
+            i = index[j.name]
+            grid = np.concatenate(  # small turns first, then the range; never at a limit
+                [start[i] + STEPS, start[i] - STEPS, np.linspace(lo, hi, GRID + 1)[1:-1]]
+            )
+            grid = grid[(grid > lo + 1e-6) & (grid < hi - 1e-6)]
+            for value in sorted(grid, key=lambda v: abs(v - start[i])):
+                trial = follow(np.where(np.arange(len(q)) == i, value, q))
+                depth, found = _penetration(model, data, adr, trial)
+                if depth < best - 1e-9:
+                    q, best, pairs, moved = trial, depth, found, True
+            if moved:
+                break
+        if best == 0.0 or not moved:
+            break
+    _penetration(model, data, adr, q)
+    if _touching(data):  # no free pose found: the first guess stays
+        return None
+    changes = [
+        f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
+        for i, j in enumerate(movable)
+        if abs(q[i] - start[i]) > 1e-12
+    ]
+    return [float(f"{v:.6g}") for v in q], changes
