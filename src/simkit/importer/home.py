@@ -82,7 +82,7 @@ def _adjacent(robot) -> set[tuple[str, str]]:
     return {tuple(sorted((a, b))) for a in solid for b in near.get(a, ()) if b in solid}
 
 
-def _model_xml(robot, base_dir: Path) -> str:
+def _model_xml(robot, base_dir: Path, also_excluded: tuple = ()) -> str:
     from simkit.model.kinematics import quat_wxyz, rpy_matrix
 
     root = ET.Element("mujoco")
@@ -108,7 +108,7 @@ def _model_xml(robot, base_dir: Path) -> str:
         for i, shape in enumerate(_shapes(link)):
             _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
     contact = ET.SubElement(root, "contact")
-    for a, b in sorted(_adjacent(robot)):
+    for a, b in sorted(_adjacent(robot) | set(also_excluded)):
         ET.SubElement(contact, "exclude", body1=a, body2=b)
     return ET.tostring(root, encoding="unicode")
 
@@ -152,6 +152,35 @@ def _between(robot, a: str, b: str) -> list:
     return [j for j in ua + ub if j.name not in common and j.movable and j.mimic is None]
 
 
+#: random configurations (seeded) a pair must touch in, with the first guess, to count as
+#: always in contact
+ALWAYS_SAMPLES = 200
+
+
+def _always_touching(robot, base_dir: Path, start: np.ndarray, follow) -> tuple:
+    """Link pairs touching at the first guess and in every one of `ALWAYS_SAMPLES` seeded
+    random configurations: URDF collision shapes that overlap wherever the joints are (Panda
+    collision primitives of links 1 and 3). The kit excludes such pairs (derive
+    collision_pairs "always", as MoveIt Setup Assistant does), so no pose can or need
+    separate them; the search must not try, or it never moves the pair it could fix."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir))
+    data = mujoco.MjData(model)
+    movable = robot.movable_joints
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    _depth, pairs = _penetration(model, data, adr, start)
+    rng = np.random.default_rng(robot.seed)
+    low = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
+    high = np.array([j.upper if j.upper is not None else math.pi for j in movable])
+    for _ in range(ALWAYS_SAMPLES if pairs else 0):
+        _depth, found = _penetration(model, data, adr, follow(rng.uniform(low, high)))
+        pairs &= found
+        if not pairs:
+            break
+    return tuple(sorted(tuple(sorted(p)) for p in pairs))
+
+
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
     or None when the spec's home is already free or the search finds no free pose. Only the
@@ -165,10 +194,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
 
     text = spec_path.read_text(encoding="utf-8")
     robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
-    model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent))
-    data = mujoco.MjData(model)
     movable = robot.movable_joints
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
     start = np.array(dict(robot.poses)["home"], dtype=float)
     index = {j.name: i for i, j in enumerate(movable)}
 
@@ -179,6 +205,10 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                 q[index[j.name]] = multiplier * q[index[leader]] + offset
         return q
 
+    always = _always_touching(robot, spec_path.parent, start, follow)
+    model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent, always))
+    data = mujoco.MjData(model)
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
     q = start.copy()
     best, pairs = _penetration(model, data, adr, q)
     if not _touching(data):  # closer than the clearance is fine at the first guess
