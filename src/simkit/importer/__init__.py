@@ -48,6 +48,25 @@ def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
     return text
 
 
+def _free_stance(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
+    """Move a floating robot's `home` out of self-contact, feet kept (stance.py); rewrite the
+    spec, reporting the change."""
+    from simkit.importer import stance, writer
+
+    found = stance.free_home(spec_path)
+    if found is None:
+        return
+    spec["poses"]["home"], changes = found
+    report.assumed(
+        doc,
+        doc.root,
+        "home: links collide at the first guess (0, or mid-range outside the limits); "
+        + ", ".join(changes)
+        + " rad or m",
+    )
+    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
+
+
 def robot_name(path: Path) -> str:
     """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
     stem = path.name.split(".")[0].lower()
@@ -86,6 +105,7 @@ def import_robot(
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
         if floating:
+            _free_stance(spec, report, doc, stage / f"{name}.yaml", path)
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
         writer.check(stage / f"{name}.yaml")
         for item in sorted(stage.rglob("*")):
