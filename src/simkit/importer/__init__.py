@@ -60,9 +60,8 @@ def _free_stance(spec: dict, report: Report, doc, spec_path: Path, path: Path) -
     report.assumed(
         doc,
         doc.root,
-        "home: links collide at the first guess (0, or mid-range outside the limits); "
-        + ", ".join(changes)
-        + " rad or m",
+        "home: at the first guess (0, or mid-range outside the limits) links collide or the "
+        "robot cannot rest on the floor; " + ", ".join(changes) + " rad or m",
     )
     spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
 

@@ -24,6 +24,8 @@ GRID = 8  # range divisions tried per joint
 SWEEPS = 2
 SAMPLES = 200  # random configurations that tell an always-touching pair
 FOOT = 0.01  # m: a link whose lowest point is this close to the robot's lowest is a foot
+SUPPORT = 0.003  # m: solid points this close to the lowest one touch the floor
+MARGIN = 0.01  # m: how far inside its support the CoM of a robot at rest must lie
 
 
 def _text(values) -> str:
@@ -125,9 +127,53 @@ def _feet_joints(robot, home, base_dir: Path) -> set[str]:
     return out
 
 
+class _Support:
+    """Where the robot touches a flat floor at a pose, and how far inside that support its
+    centre of mass lies (visual solids, as standing.py places the robot)."""
+
+    def __init__(self, robot, base_dir: Path):
+        from simkit.importer.standing import _points
+
+        self.robot = robot
+        self.points = {
+            link.name: np.vstack([_points(shape, base_dir) for shape in link.shapes])
+            for link in robot.links
+            if link.shapes
+        }
+        self.mass = {
+            link.name: (link.inertial.mass, np.asarray(link.inertial.com))
+            for link in robot.links
+            if link.inertial is not None
+        }
+
+    def margin(self, q) -> float:
+        """m the CoM's ground projection lies inside the convex hull of the lowest points
+        (within SUPPORT of the lowest); negative outside, or for a point or a line of
+        support (point feet side by side: it can only balance, never rest)."""
+        from scipy.spatial import ConvexHull, QhullError
+
+        from simkit.model.kinematics import forward
+
+        poses = forward(self.robot, list(q))
+        world = [pts @ poses[n][:3, :3].T + poses[n][:3, 3] for n, pts in self.points.items()]
+        if not world or not self.mass:
+            return math.inf
+        every = np.vstack(world)
+        feet = every[every[:, 2] <= every[:, 2].min() + SUPPORT][:, :2]
+        total = sum(m for m, _ in self.mass.values())
+        com = sum(m * (poses[n][:3, :3] @ c + poses[n][:3, 3]) for n, (m, c) in self.mass.items())
+        com = np.asarray(com)[:2] / total
+        try:
+            hull = ConvexHull(feet)
+        except (QhullError, ValueError):  # fewer than 3 points, or all on a line
+            return -float(np.min(np.linalg.norm(feet - com, axis=1))) - MARGIN
+        return float(np.min(-(hull.equations[:, :2] @ com + hull.equations[:, 2])))
+
+
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
-    """A home pose (spec order) whose separable link pairs do not touch, and the changes
-    made (`joint: a -> b`); None when home is already free or no grid pose frees it."""
+    """A home pose (spec order) whose separable link pairs do not touch and on which the
+    robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
+    made (`joint: a -> b`); None when home already is, or no grid pose is better."""
     import mujoco
     import yaml
 
@@ -155,36 +201,51 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     def depth(q) -> float:
         return sum(d for p, d in _contacts(model, data, adr, q).items() if p not in always)
 
-    start = np.array(home, dtype=float)
-    q, best = start.copy(), depth(start)
-    if best == 0.0:
-        return None
-    frozen = _feet_joints(robot, home, spec_path.parent)
     index = {j.name: i for i, j in enumerate(movable)}
-    for _ in range(SWEEPS):
-        for j, (lo, hi) in reversed(list(zip(movable, limits, strict=True))):
-            if j.name in frozen or j.mimic is not None:
-                continue
-            i = index[j.name]
-            grid = np.linspace(lo, hi, GRID + 1)[1:-1]  # not at a limit, where a servo rests
-            for value in sorted(grid, key=lambda v: abs(v - start[i])):
-                trial = q.copy()
-                trial[i] = value
-                for m in movable:  # mimic joints follow their leaders
-                    if m.mimic is not None and m.mimic[0] in index:
-                        trial[index[m.name]] = m.mimic[1] * trial[index[m.mimic[0]]] + m.mimic[2]
-                got = depth(trial)
-                if got < best - 1e-9:
-                    q, best = trial, got
-            if best == 0.0:
-                break
-        if best == 0.0:
-            break
-    if best > 0.0:
-        return None
+
+    def search(q, score, done, frozen, divisions=GRID):
+        """Greedy: one joint at a time (distal first) to the grid value that most improves
+        `score(q)` (higher is better), until `done(best)`."""
+        best = score(q)
+        for _ in range(SWEEPS):
+            for j, (lo, hi) in reversed(list(zip(movable, limits, strict=True))):
+                if done(best):
+                    return q
+                if j.name in frozen or j.mimic is not None:
+                    continue
+                i = index[j.name]
+                grid = np.linspace(lo, hi, divisions + 1)[1:-1]  # not at a limit (a servo rests)
+                for value in sorted(grid, key=lambda v: abs(v - start[i])):
+                    trial = q.copy()
+                    trial[i] = value
+                    for m in movable:  # mimic joints follow their leaders
+                        if m.mimic is not None and m.mimic[0] in index:
+                            lead, mult, off = m.mimic
+                            trial[index[m.name]] = mult * trial[index[lead]] + off
+                    got = score(trial)
+                    if got > best + 1e-9:
+                        q, best = trial, got
+        return q
+
+    start = np.array(home, dtype=float)
+    q = start
+    if depth(q) > 0.0:
+        feet = _feet_joints(robot, home, spec_path.parent)
+        q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
+        if depth(q) > 0.0:
+            q = start
+    support = _Support(robot, spec_path.parent)
+    if support.margin(q) < MARGIN:
+        free = depth(q)
+
+        def stable(t) -> float:
+            return support.margin(t) if depth(t) <= free + 1e-9 else -math.inf
+
+        found = search(q, stable, lambda b: b >= MARGIN, set(), 4 * GRID)
+        q = found if support.margin(found) >= MARGIN else q  # only a pose that rests
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
         for i, j in enumerate(movable)
         if abs(q[i] - start[i]) > 1e-12
     ]
-    return [float(f"{v:.6g}") for v in q], changes
+    return ([float(f"{v:.6g}") for v in q], changes) if changes else None
