@@ -157,7 +157,7 @@ def check_models(kit: Kit) -> list[Finding]:
                     "",
                 )
             )
-    scale = max(1.0, float(np.abs(tau_mj).max()))
+    scale = max(1.0, float(np.max(np.abs(tau_mj), initial=0.0)))  # no joints: empty
     findings.append(
         compare(
             "gravity.urdf_vs_mjcf",
@@ -308,7 +308,7 @@ def check_parameters(kit: Kit) -> list[Finding]:
         compare(
             "mjcf.joint_dynamics",
             "armature, damping, friction loss vs robot.json",
-            [[j["armature"], j["damping"], j["friction"]] for j in joints],
+            np.reshape([[j["armature"], j["damping"], j["friction"]] for j in joints], (-1, 3)),
             np.column_stack(
                 [mj.dof_armature[dofs], mj.dof_damping[dofs], mj.dof_frictionloss[dofs]]
             ),

@@ -160,7 +160,8 @@ def convert(
         # a floor to stand on (the legged checks drop the robot onto it)
         spec["mjcf"] = {"floor": {"name": "floor", "size": [0.0, 0.0, 0.05]}}
     tool = _deepest(spec_root, spec_joints, spec_frames)
-    if tool:
+    if tool and any(j["type"] not in ("fixed", "floating") for j in spec_joints):
+        # no tool on a robot without joints (a rigid quadrotor): nothing moves it
         spec["tool_frame"] = tool
     if colours:
         spec["materials"] = [{"name": n, "rgba": list(c)} for c, n in colours.items()]
