@@ -26,6 +26,7 @@ SAMPLES = 200  # random configurations that tell an always-touching pair
 FOOT = 0.01  # m: a link whose lowest point is this close to the robot's lowest is a foot
 SUPPORT = 0.003  # m: solid points this close to the lowest one touch the floor
 MARGIN = 0.01  # m: how far inside its support the CoM of a robot at rest must lie
+STABLE_SAMPLES = 2000  # random poses tried for one the robot rests on
 
 
 def _text(values) -> str:
@@ -170,6 +171,24 @@ class _Support:
         return float(np.min(-(hull.equations[:, :2] @ com + hull.equations[:, 2])))
 
 
+def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
+    """The seeded random pose nearest `q` (joint-space distance) on which the robot rests
+    (CoM at least MARGIN inside its support) with no more self-contact than `q`; `q` itself
+    when none of them does. Random draws, not one joint at a time: a flying arm must move
+    two joints together to lift above its frame (Borinot)."""
+    free = depth(q)
+    lo, hi = np.array(limits, dtype=float).T
+    draws = lo + np.random.default_rng(0).random((STABLE_SAMPLES, len(movable))) * (hi - lo)
+    for j in movable:  # mimic joints follow their leaders; the rest of a draw is free
+        if j.mimic is not None and j.mimic[0] in index:
+            lead, mult, off = j.mimic
+            draws[:, index[j.name]] = mult * draws[:, index[lead]] + off
+    for trial in draws[np.argsort(np.linalg.norm(draws - q, axis=1), kind="stable")]:
+        if support.margin(trial) >= MARGIN and depth(trial) <= free + 1e-9:
+            return trial
+    return q
+
+
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) whose separable link pairs do not touch and on which the
     robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
@@ -203,7 +222,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
 
     index = {j.name: i for i, j in enumerate(movable)}
 
-    def search(q, score, done, frozen, divisions=GRID):
+    def search(q, score, done, frozen):
         """Greedy: one joint at a time (distal first) to the grid value that most improves
         `score(q)` (higher is better), until `done(best)`."""
         best = score(q)
@@ -214,7 +233,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                 if j.name in frozen or j.mimic is not None:
                     continue
                 i = index[j.name]
-                grid = np.linspace(lo, hi, divisions + 1)[1:-1]  # not at a limit (a servo rests)
+                grid = np.linspace(lo, hi, GRID + 1)[1:-1]  # not at a limit, where a servo rests
                 for value in sorted(grid, key=lambda v: abs(v - start[i])):
                     trial = q.copy()
                     trial[i] = value
@@ -236,13 +255,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
             q = start
     support = _Support(robot, spec_path.parent)
     if support.margin(q) < MARGIN:
-        free = depth(q)
-
-        def stable(t) -> float:
-            return support.margin(t) if depth(t) <= free + 1e-9 else -math.inf
-
-        found = search(q, stable, lambda b: b >= MARGIN, set(), 4 * GRID)
-        q = found if support.margin(found) >= MARGIN else q  # only a pose that rests
+        q = _resting(q, support, depth, movable, limits, index)
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
         for i, j in enumerate(movable)
