@@ -216,6 +216,7 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
 
     if not len(q):
         return []
+    q = _follow_mimics(robot, q)
     skip = welded_pairs(robot) | {tuple(sorted(p)) for p in jointed_pairs(robot)}
     first = first_contacts(robot, q[:1], sorted(skip))
     candidates = {pair for pair, index in first.items() if index == 0}
@@ -238,6 +239,19 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
             touching.add((a, b) if a < b else (b, a))
         candidates &= touching
     return sorted(candidates)
+
+
+def _follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """`q` (sampled_joints order) with each mimic joint at its leader's value times the
+    multiplier plus the offset, as the kit's MJCF equality holds it."""
+    names = [name for name, _, _ in sampled_joints(robot)]
+    index = {name: i for i, name in enumerate(names)}
+    q = np.array(q, dtype=float)
+    for joint in robot.joints:
+        if joint.mimic is not None and joint.name in index and joint.mimic[0] in index:
+            leader, multiplier, offset = joint.mimic
+            q[:, index[joint.name]] = multiplier * q[:, index[leader]] + offset
+    return q
 
 
 #: configurations (the first of the sampled ones) a pair must be in contact in to be "Always"

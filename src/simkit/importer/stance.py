@@ -171,6 +171,15 @@ class _Support:
         return float(np.min(-(hull.equations[:, :2] @ com + hull.equations[:, 2])))
 
 
+def _follow(q: np.ndarray, movable, index: dict[str, int]) -> np.ndarray:
+    """Rows of joint values with each mimic joint at its leader's (the kit's equality)."""
+    for j in movable:
+        if j.mimic is not None and j.mimic[0] in index:
+            leader, multiplier, offset = j.mimic
+            q[:, index[j.name]] = multiplier * q[:, index[leader]] + offset
+    return q
+
+
 def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
     """The seeded random pose nearest `q` (joint-space distance) on which the robot rests
     (CoM at least MARGIN inside its support) with no more self-contact than `q`; `q` itself
@@ -179,10 +188,7 @@ def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
     free = depth(q)
     lo, hi = np.array(limits, dtype=float).T
     draws = lo + np.random.default_rng(0).random((STABLE_SAMPLES, len(movable))) * (hi - lo)
-    for j in movable:  # mimic joints follow their leaders; the rest of a draw is free
-        if j.mimic is not None and j.mimic[0] in index:
-            lead, mult, off = j.mimic
-            draws[:, index[j.name]] = mult * draws[:, index[lead]] + off
+    draws = _follow(draws, movable, index)
     for trial in draws[np.argsort(np.linalg.norm(draws - q, axis=1), kind="stable")]:
         if support.margin(trial) >= MARGIN and depth(trial) <= free + 1e-9:
             return trial
@@ -209,18 +215,18 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     movable = robot.movable_joints
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
     limits = [(j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi) for j in movable]
-    unit = np.random.default_rng(0).random((SAMPLES, len(movable)))
+    index = {j.name: i for i, j in enumerate(movable)}
+    lo, hi = np.array(limits, dtype=float).T
+    draws = lo + np.random.default_rng(0).random((SAMPLES, len(movable))) * (hi - lo)
+    draws = _follow(draws, movable, index)
     always: set | None = None
-    for u in unit:
-        q = np.array([lo + x * (hi - lo) for x, (lo, hi) in zip(u, limits, strict=True)])
+    for q in draws:
         touching = set(_contacts(model, data, adr, q))
         always = touching if always is None else always & touching
     always = always or set()
 
     def depth(q) -> float:
         return sum(d for p, d in _contacts(model, data, adr, q).items() if p not in always)
-
-    index = {j.name: i for i, j in enumerate(movable)}
 
     def search(q, score, done, frozen):
         """Greedy: one joint at a time (distal first) to the grid value that most improves
@@ -237,10 +243,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                 for value in sorted(grid, key=lambda v: abs(v - start[i])):
                     trial = q.copy()
                     trial[i] = value
-                    for m in movable:  # mimic joints follow their leaders
-                        if m.mimic is not None and m.mimic[0] in index:
-                            lead, mult, off = m.mimic
-                            trial[index[m.name]] = mult * trial[index[lead]] + off
+                    trial = _follow(trial[None, :], movable, index)[0]
                     got = score(trial)
                     if got > best + 1e-9:
                         q, best = trial, got
