@@ -1,10 +1,10 @@
 """The pairs robot.json lists as in contact in every configuration (`collision_pairs.always`,
 which the MJCF excludes) really do touch: at home and at the first sampled configurations,
-regenerated from the recorded seed (derive/collision_pairs.py's METHOD), some geom of one
-link penetrates some geom of the other in the kit's own MJCF. So a pair cannot be excluded
-from contact unless its collision geometry overlaps wherever the joints are.
+regenerated from the recorded seed (derive/collision_pairs.py's METHOD) with mimic joints
+following their leaders, some geom of one link penetrates some geom of the other in the kit's
+own MJCF. So a pair cannot be excluded from contact unless its collision geometry overlaps
+wherever the joints are.
 """
-
 from __future__ import annotations
 
 import math
@@ -51,6 +51,10 @@ def not_touching(kit: Kit, model: mujoco.MjModel) -> list[str]:
             if j["type"] == "continuous":
                 lo, hi = -math.pi, math.pi
             q[name] = lo + x * (hi - lo)
+        for name in names:  # mimic joints follow their leaders (the MJCF's equality)
+            mimic = joints[name].get("mimic")
+            if mimic and mimic["joint"] in q:
+                q[name] = mimic["multiplier"] * q[mimic["joint"]] + mimic["offset"]
         configs.append((f"sample {k}", q))
     data = mujoco.MjData(model)
     apart = []
