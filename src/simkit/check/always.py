@@ -5,6 +5,7 @@ following their leaders, some geom of one link penetrates some geom of the other
 own MJCF. So a pair cannot be excluded from contact unless its collision geometry overlaps
 wherever the joints are.
 """
+
 from __future__ import annotations
 
 import math
