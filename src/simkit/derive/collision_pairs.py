@@ -207,6 +207,14 @@ def welded_pairs(robot: Robot) -> set[tuple[str, str]]:
     return out
 
 
+def _kit_collides(link: Link) -> bool:
+    """Whether the kit's MJCF gives the link collision geoms (emit/mjcf.py: a link whose
+    collision is `primitives` and lists none has none; this model would collide its solid)."""
+    if link.collision_primitives:
+        return True
+    return link.collision_method != "primitives" and (bool(link.collision) or link.solid is not None)
+
+
 def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
     """Link pairs the kit's MJCF would let collide whose collision geometry is in contact in
     every configuration of `q` (MoveIt Setup Assistant's "Always"): a URDF's collision shapes
@@ -219,7 +227,8 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
     q = _follow_mimics(robot, q)
     skip = welded_pairs(robot) | {tuple(sorted(p)) for p in jointed_pairs(robot)}
     first = first_contacts(robot, q[:1], sorted(skip))
-    candidates = {pair for pair, index in first.items() if index == 0}
+    kit = {link.name for link in robot.links if _kit_collides(link)}
+    candidates = {p for p, index in first.items() if index == 0 and set(p) <= kit}
     solid = sorted(link.name for link in robot.links if has_geometry(link))
     names = [j for j, _, _ in sampled_joints(robot)]
     others = [p for p in itertools.combinations(solid, 2) if p not in candidates]
