@@ -212,7 +212,8 @@ def _kit_collides(link: Link) -> bool:
     collision is `primitives` and lists none has none; this model would collide its solid)."""
     if link.collision_primitives:
         return True
-    return link.collision_method != "primitives" and (bool(link.collision) or link.solid is not None)
+    has_mesh = bool(link.collision) or link.solid is not None
+    return link.collision_method != "primitives" and has_mesh
 
 
 def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
