@@ -106,13 +106,13 @@ def _contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
 
 def _feet_joints(robot, home, base_dir: Path) -> set[str]:
     """Joints on the way from the base to any link whose lowest point at home is a foot."""
-    from simkit.importer.standing import _points
+    from simkit.importer.standing import _points, floor_shapes
     from simkit.model.kinematics import forward
 
     poses = forward(robot, home)
     low: dict[str, float] = {}
     for link in robot.links:
-        for shape in link.shapes:
+        for shape in floor_shapes(link):
             world = _points(shape, base_dir) @ poses[link.name][:3, :3].T
             z = float((world[:, 2] + poses[link.name][2, 3]).min())
             low[link.name] = min(low.get(link.name, math.inf), z)
@@ -130,16 +130,16 @@ def _feet_joints(robot, home, base_dir: Path) -> set[str]:
 
 class _Support:
     """Where the robot touches a flat floor at a pose, and how far inside that support its
-    centre of mass lies (visual solids, as standing.py places the robot)."""
+    centre of mass lies (the geometry that touches the floor, as standing.py places it)."""
 
     def __init__(self, robot, base_dir: Path):
-        from simkit.importer.standing import _points
+        from simkit.importer.standing import _points, floor_shapes
 
         self.robot = robot
         self.points = {
-            link.name: np.vstack([_points(shape, base_dir) for shape in link.shapes])
+            link.name: np.vstack([_points(shape, base_dir) for shape in floor_shapes(link)])
             for link in robot.links
-            if link.shapes
+            if floor_shapes(link)
         }
         self.mass = {
             link.name: (link.inertial.mass, np.asarray(link.inertial.com))
