@@ -200,3 +200,27 @@ def test_imported_rigid_quadrotor_rests(tmp_path, kit_factory):
     done = import_robot(_write(tmp_path, urdf), tmp_path / "out", floating=True)
     result = kit_factory(str(done.spec_path))
     assert "legged.stand.height" in {f.check for f in result.findings}
+
+
+def test_flying_arm_rests_on_its_frame(tmp_path):
+    """A frame with a thin two-link arm hanging below: balanced on the arm's tip it cannot
+    rest, so home folds the arm up and the frame carries the weight (the arm's servos do not)."""
+    from simkit.importer.stance import MARGIN, _Support
+    from simkit.model.resolve import resolve
+
+    urdf = (
+        '<robot name="drone">'
+        + _box("frame", "0.4 0.4 0.05", mass=1.5)
+        + _box("upper", "0.01 0.01 0.2", "0 0 -0.1", 0.05)
+        + _box("lower", "0.01 0.01 0.2", "0 0 -0.1", 0.05)
+        + _joint("j1", "frame", "upper", "0 0 0.02", "0 1 0", "2.5")  # through the frame
+        + _joint("j2", "upper", "lower", "0 0 -0.2", "0 1 0", "2.5")
+        + "</robot>"
+    )
+    done = import_robot(_write(tmp_path, urdf), tmp_path / "out", floating=True)
+    spec, doc = load_spec(done.spec_path)
+    robot = resolve(spec, doc.text.encode(), done.spec_path.name)
+    support = _Support(robot, done.spec_path.parent)
+    assert support.margin([0.0, 0.0]) < MARGIN  # the first guess stands on the arm's tip
+    home = spec.poses["home"]
+    assert home != (0.0, 0.0) and support.margin(home, frame_only=True) >= MARGIN

@@ -128,6 +128,15 @@ def _feet_joints(robot, home, base_dir: Path) -> set[str]:
     return out
 
 
+def _chain(parent: dict, link: str) -> list:
+    """The joints from the root down to `link`."""
+    out = []
+    while link in parent:
+        out.append(parent[link])
+        link = parent[link].parent
+    return out
+
+
 class _Support:
     """Where the robot touches a flat floor at a pose, and how far inside that support its
     centre of mass lies (the geometry that touches the floor, as standing.py places it)."""
@@ -141,16 +150,24 @@ class _Support:
             for link in robot.links
             if floor_shapes(link)
         }
+        parent = {j.child: j for j in robot.joints}
+        self.frame = {  # links no movable joint separates from the floating base
+            link.name
+            for link in robot.links
+            if all(j.type in ("fixed", "floating") for j in _chain(parent, link.name))
+        }
         self.mass = {
             link.name: (link.inertial.mass, np.asarray(link.inertial.com))
             for link in robot.links
             if link.inertial is not None
         }
 
-    def margin(self, q) -> float:
+    def margin(self, q, frame_only: bool = False) -> float:
         """m the CoM's ground projection lies inside the convex hull of the lowest points
         (within SUPPORT of the lowest); negative outside, or for a point or a line of
-        support (point feet side by side: it can only balance, never rest)."""
+        support (point feet side by side: it can only balance, never rest). `frame_only`:
+        -inf unless every lowest point is on the base or links welded to it (no servo
+        carries the weight)."""
         from scipy.spatial import ConvexHull, QhullError
 
         from simkit.model.kinematics import forward
@@ -160,7 +177,11 @@ class _Support:
         if not world or not self.mass:
             return math.inf
         every = np.vstack(world)
-        feet = every[every[:, 2] <= every[:, 2].min() + SUPPORT][:, :2]
+        low = every[:, 2] <= every[:, 2].min() + SUPPORT
+        owners = np.repeat(list(self.points), [len(p) for p in self.points.values()])
+        if frame_only and not set(owners[low]) <= self.frame:
+            return -math.inf
+        feet = every[low][:, :2]
         total = sum(m for m, _ in self.mass.values())
         com = sum(m * (poses[n][:3, :3] @ c + poses[n][:3, 3]) for n, (m, c) in self.mass.items())
         com = np.asarray(com)[:2] / total
@@ -182,16 +203,19 @@ def _follow(q: np.ndarray, movable, index: dict[str, int]) -> np.ndarray:
 
 def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
     """The seeded random pose nearest `q` (joint-space distance) on which the robot rests
-    (CoM at least MARGIN inside its support) with no more self-contact than `q`; `q` itself
-    when none of them does. Random draws, not one joint at a time: a flying arm must move
+    (CoM at least MARGIN inside its support) with no more self-contact than `q`, resting on
+    its frame alone where a draw allows (Hextilt's arm servos, 0.3 N m, cannot carry it);
+    `q` itself when none of them does. Random draws, not one joint at a time: a flying arm must move
     two joints together to lift above its frame (Borinot)."""
     free = depth(q)
     lo, hi = np.array(limits, dtype=float).T
     draws = lo + np.random.default_rng(0).random((STABLE_SAMPLES, len(movable))) * (hi - lo)
     draws = _follow(draws, movable, index)
-    for trial in draws[np.argsort(np.linalg.norm(draws - q, axis=1), kind="stable")]:
-        if support.margin(trial) >= MARGIN and depth(trial) <= free + 1e-9:
-            return trial
+    ordered = draws[np.argsort(np.linalg.norm(draws - q, axis=1), kind="stable")]
+    for frame_only in (True, False):  # on its frame if it can (a drone), else on its joints
+        for trial in ordered:
+            if support.margin(trial, frame_only) >= MARGIN and depth(trial) <= free + 1e-9:
+                return trial
     return q
 
 
