@@ -157,7 +157,7 @@ def check_models(kit: Kit) -> list[Finding]:
                     "",
                 )
             )
-    scale = max(1.0, float(np.abs(tau_mj).max()))
+    scale = max(1.0, float(np.max(np.abs(tau_mj), initial=0.0)))  # no joints: empty
     findings.append(
         compare(
             "gravity.urdf_vs_mjcf",
@@ -308,7 +308,7 @@ def check_parameters(kit: Kit) -> list[Finding]:
         compare(
             "mjcf.joint_dynamics",
             "armature, damping, friction loss vs robot.json",
-            [[j["armature"], j["damping"], j["friction"]] for j in joints],
+            np.reshape([[j["armature"], j["damping"], j["friction"]] for j in joints], (-1, 3)),
             np.column_stack(
                 [mj.dof_armature[dofs], mj.dof_damping[dofs], mj.dof_frictionloss[dofs]]
             ),
@@ -378,13 +378,22 @@ def _servos(kit: Kit, mj: mujoco.MjModel, servos: list[dict]) -> list[Finding]:
 
 
 def _excludes(kit: Kit, mj: mujoco.MjModel) -> Finding:
-    """MJCF <exclude> pairs are exactly the links joined by a joint."""
+    """MJCF <exclude> pairs are exactly the links joined by a joint, plus the pairs robot.json
+    lists as in contact in every configuration (`collision_pairs.always`), each of which
+    must really touch (check/always.py)."""
+    from simkit.check.always import not_touching
+
     links = {link["name"] for link in kit.doc["links"]}
     adjacent = {
         tuple(sorted((j["parent"], j["child"])))
         for j in kit.joints + kit.doc.get("fixed_joints", [])
         if j["parent"] in links and j["child"] in links
     }
+    always = [tuple(sorted(p)) for p in (kit.doc.get("collision_pairs") or {}).get("always", [])]
+    adjacent |= set(always)
+    apart = not_touching(kit, mj)
+    if apart:
+        return require("mjcf.excludes", False, f"excluded as always touching but apart: {apart}")
     excluded = set()
     for sig in mj.exclude_signature:
         a, b = int(sig) >> 16, int(sig) & 0xFFFF

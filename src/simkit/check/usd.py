@@ -350,10 +350,13 @@ def check_usd(kit: Kit) -> list[Finding]:
         joints = joints_from_parser(parsed)
         arts = parsed.get(UsdPhysics.ObjectType.Articulation, ([], []))[1]
         bodies = {str(b) for a in arts for b in a.articulatedBodies}
+        # one rigid body and no joint (a quadrotor's frame) articulates nothing: the parser
+        # lists no articulation, or one without bodies; usd.bodies checked its rigid body
+        alone = len(links) == 1 and not kit.joints and not kit.doc.get("fixed_joints")
         findings.append(
             require(
                 "usd.articulation",
-                len(arts) == 1 and set(links.values()) <= bodies,
+                (len(arts) == 1 and set(links.values()) <= bodies) or (alone and len(arts) <= 1),
                 f"UsdPhysics parser: {len(arts)} articulation(s) holding every link",
             )
         )

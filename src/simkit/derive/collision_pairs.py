@@ -22,7 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from simkit.model.kinematics import quat_wxyz, rpy_matrix
+from simkit.model.kinematics import jointed_pairs, quat_wxyz, rpy_matrix
 from simkit.model.robot import Link, Robot, Shape
 
 SAMPLES = 10_000
@@ -187,12 +187,96 @@ def first_contacts(
     return first
 
 
+def welded_pairs(robot: Robot) -> set[tuple[str, str]]:
+    """Link pairs whose contacts MuJoCo filters in the kit's MJCF by itself: bodies welded
+    together by fixed joints, and a welded group with its parent group (the parent filter)."""
+    parent = {j.child: j for j in robot.joints}
+
+    def weld(link: str) -> str:
+        while link in parent and parent[link].type == "fixed":
+            link = parent[link].parent
+        return link
+
+    groups = {link.name: weld(link.name) for link in robot.links}
+    up = {g: weld(parent[g].parent) for g in set(groups.values()) if g in parent}
+    out = set()
+    for a, b in itertools.combinations(sorted(groups), 2):
+        ga, gb = groups[a], groups[b]
+        if ga == gb or up.get(ga) == gb or up.get(gb) == ga:
+            out.add((a, b))
+    return out
+
+
+def _kit_collides(link: Link) -> bool:
+    """Whether the kit's MJCF gives the link collision geoms (emit/mjcf.py: a link whose
+    collision is `primitives` and lists none has none; this model would collide its solid)."""
+    if link.collision_primitives:
+        return True
+    has_mesh = bool(link.collision) or link.solid is not None
+    return link.collision_method != "primitives" and has_mesh
+
+
+def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
+    """Link pairs the kit's MJCF would let collide whose collision geometry is in contact in
+    every configuration of `q` (MoveIt Setup Assistant's "Always"): a URDF's collision shapes
+    that overlap wherever the joints are (Talos's hip-yaw and thigh hulls) can never be
+    separated, so their contact is an artefact of the geometry, and the kit excludes it."""
+    import mujoco
+
+    if not len(q):
+        return []
+    q = _follow_mimics(robot, q)
+    skip = welded_pairs(robot) | {tuple(sorted(p)) for p in jointed_pairs(robot)}
+    first = first_contacts(robot, q[:1], sorted(skip))
+    kit = {link.name for link in robot.links if _kit_collides(link)}
+    candidates = {p for p, index in first.items() if index == 0 and set(p) <= kit}
+    solid = sorted(link.name for link in robot.links if has_geometry(link))
+    names = [j for j, _, _ in sampled_joints(robot)]
+    others = [p for p in itertools.combinations(solid, 2) if p not in candidates]
+    model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, others))
+    data = mujoco.MjData(model)
+    adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
+    body_name = [model.body(i).name for i in range(model.nbody)]
+    for row in q[1:]:
+        if not candidates:
+            break
+        data.qpos[adr] = row
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        touching = set()
+        for g1, g2 in data.contact.geom[: data.ncon]:
+            a, b = body_name[model.geom_bodyid[g1]], body_name[model.geom_bodyid[g2]]
+            touching.add((a, b) if a < b else (b, a))
+        candidates &= touching
+    return sorted(candidates)
+
+
+def _follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """`q` (sampled_joints order) with each mimic joint at its leader's value times the
+    multiplier plus the offset, as the kit's MJCF equality holds it."""
+    names = [name for name, _, _ in sampled_joints(robot)]
+    index = {name: i for i, name in enumerate(names)}
+    q = np.array(q, dtype=float)
+    for joint in robot.joints:
+        if joint.mimic is not None and joint.name in index and joint.mimic[0] in index:
+            leader, multiplier, offset = joint.mimic
+            q[:, index[joint.name]] = multiplier * q[:, index[leader]] + offset
+    return q
+
+
+#: configurations (the first of the sampled ones) a pair must be in contact in to be "Always"
+ALWAYS_SAMPLES = 1000
+
+
 def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
-    """Adjacent and never-in-contact link pairs (`products.collision_pairs`: the SRDF and
-    robot.json `collision_pairs`); the seed is the spec's."""
+    """Adjacent, always-in-contact and never-in-contact link pairs
+    (`products.collision_pairs`: the SRDF, the MJCF and USD excludes and robot.json
+    `collision_pairs`); the seed is the spec's. `always` is written only when not empty."""
     seed = robot.seed
     adjacent = adjacent_pairs(robot)
-    first = first_contacts(robot, configurations(robot, seed, samples), adjacent)
+    q = configurations(robot, seed, samples)
+    first = first_contacts(robot, q, adjacent)
+    always = always_pairs(robot, q[:ALWAYS_SAMPLES])
     block = {
         "method": METHOD,
         "seed": seed,
@@ -202,5 +286,7 @@ def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
         "never": [list(p) for p, index in first.items() if index is None],
         "first_contact": {f"{a} {b}": i for (a, b), i in first.items() if i is not None},
     }
+    if always:
+        block["always"] = [list(p) for p in always]
     seeds = {**robot.products.seeds, "collision_pairs": seed}
     return replace(robot, products=replace(robot.products, collision_pairs=block, seeds=seeds))

@@ -20,7 +20,9 @@ def depth_function(robot: Robot, joints: Sequence[str]) -> Callable[[Sequence[fl
     of `joints` (rad or m), every other joint at 0."""
     import mujoco
 
-    model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, adjacent_pairs(robot)))
+    always = [tuple(p) for p in (robot.products.collision_pairs or {}).get("always", [])]
+    skip = sorted(set(adjacent_pairs(robot)) | set(always))  # as the kit's MJCF excludes them
+    model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, skip))
     data = mujoco.MjData(model)
     adr = [int(model.jnt_qposadr[model.joint(name).id]) for name in joints]
 

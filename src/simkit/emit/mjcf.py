@@ -203,6 +203,8 @@ def emit(robot: Robot) -> dict[str, bytes]:
     contact = sub(mujoco, "contact")
     for a, b in jointed_pairs(robot):
         sub(contact, "exclude", body1=a, body2=b)
+    for a, b in (robot.products.collision_pairs or {}).get("always", []):
+        sub(contact, "exclude", body1=a, body2=b)  # in contact in every configuration
     mimics = [j for j in robot.joints if j.mimic is not None]
     if mimics:
         equality = sub(mujoco, "equality")

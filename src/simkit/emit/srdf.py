@@ -90,6 +90,7 @@ def emit(robot: Robot) -> dict[str, bytes]:
     pairs = robot.products.collision_pairs or {}
     disabled = [(a, b, "Adjacent") for a, b in pairs.get("adjacent", [])]
     disabled += [(a, b, "Never") for a, b in pairs.get("never", [])]
+    disabled += [(a, b, "Always") for a, b in pairs.get("always", [])]
     for a, b, reason in sorted(disabled):
         sub(root, "disable_collisions", link1=a, link2=b, reason=reason)
     return {layout.srdf(robot.name): to_bytes(root, HEADER.format(spec=robot.spec_file))}

@@ -332,11 +332,16 @@ def stage_text(robot: Robot) -> str:
     poses = forward(robot)
     for link in robot.links:
         _link(stage, root, robot, link, poses[link.name], materials)
-    for parent, child in jointed_pairs(robot):
-        # joints already ignore contacts between the two bodies they join; the explicit pair
-        # matches the MJCF <exclude> for readers that merge or drop fixed joints
+    # joints already ignore contacts between the two bodies they join; the explicit pair
+    # matches the MJCF <exclude> for readers that merge or drop fixed joints (and the pairs
+    # in contact in every configuration, collision_pairs.always_pairs)
+    always = [tuple(p) for p in (robot.products.collision_pairs or {}).get("always", [])]
+    targets: dict[str, list[str]] = {}
+    for parent, child in [*jointed_pairs(robot), *always]:
+        targets.setdefault(child, []).append(f"{root}/{prim_name(parent)}")
+    for child, paths in targets.items():
         api = UsdPhysics.FilteredPairsAPI.Apply(stage.GetPrimAtPath(f"{root}/{prim_name(child)}"))
-        api.CreateFilteredPairsRel().SetTargets([f"{root}/{prim_name(parent)}"])
+        api.CreateFilteredPairsRel().SetTargets(paths)
     stage.DefinePrim(f"{root}/joints", "Scope")
     for joint in robot.joints:
         if joint.type == "floating":

@@ -29,9 +29,11 @@ class Imported:
 
 
 def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
-    """Raise the floating base so the robot stands on the floor at home; rewrite the spec."""
+    """Move home out of self-contact and onto a stance it rests on (`_free_stance`), raise
+    the floating base so the robot stands on the floor at home; rewrite the spec."""
     from simkit.importer import standing, writer
 
+    _free_stance(spec, report, doc, spec_path, path)
     height = standing.standing_height(spec_path)
     if height is None:
         return spec_path.read_text(encoding="utf-8")
@@ -127,3 +129,21 @@ def import_robot(
     return Imported(
         out_dir / f"{name}.yaml", tuple(report.lines), len(mesh_writer.done), len(spec["links"])
     )
+
+
+def _free_stance(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
+    """Move a floating robot's `home` out of self-contact, feet kept (stance.py); rewrite the
+    spec, reporting the change."""
+    from simkit.importer import stance, writer
+
+    found = stance.free_home(spec_path)
+    if found is None:
+        return
+    spec["poses"]["home"], changes = found
+    report.assumed(
+        doc,
+        doc.root,
+        "home: at the first guess (0, or mid-range outside the limits) links collide or the "
+        "robot cannot rest on the floor; " + ", ".join(changes) + " rad or m",
+    )
+    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")

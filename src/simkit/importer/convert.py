@@ -144,6 +144,8 @@ def convert(
         if link_name in by_child:
             load = _load(source, link_name, links, kids, by_child)
             spec_joints.append(joint_spec(source, by_child[link_name], report, load))
+    if floating and source.root.find("link/collision") is None:
+        _visual_collision(source, spec_links, report)
     if floating and has_mass(links[root]) is False and not has_geometry(links[root]):
         report.changed(source, links[root], "massless root of a floating base")
     spec: dict = {
@@ -158,7 +160,8 @@ def convert(
         # a floor to stand on (the legged checks drop the robot onto it)
         spec["mjcf"] = {"floor": {"name": "floor", "size": [0.0, 0.0, 0.05]}}
     tool = _deepest(spec_root, spec_joints, spec_frames)
-    if tool:
+    if tool and any(j["type"] not in ("fixed", "floating") for j in spec_joints):
+        # no tool on a robot without joints (a rigid quadrotor): nothing moves it
         spec["tool_frame"] = tool
     if colours:
         spec["materials"] = [{"name": n, "rgba": list(c)} for c, n in colours.items()]
@@ -179,6 +182,26 @@ def convert(
     if spec_frames:
         spec["frames"] = spec_frames
     return spec
+
+
+def _visual_collision(source: Source, spec_links: list[dict], report: Report) -> None:
+    """A floating robot whose URDF has no `<collision>` at all (a visual-only model such as
+    human.urdf) would fall through the floor: each link with a visual solid collides with
+    that solid's convex hull instead (`collision: mesh`), marked estimated and reported."""
+    done = 0
+    for link in spec_links:
+        if link.get("solid") and link.get("collision") == "primitives":
+            link.pop("collision_primitives", None)
+            link["collision"] = "mesh"
+            link["estimated"] = [*link.get("estimated", []), "collision"]
+            done += 1
+    if done:
+        report.estimated(
+            source,
+            source.root,
+            f"no <collision> in the URDF: {done} links collide with their visual solid's "
+            "convex hull (a floating base needs something to stand on)",
+        )
 
 
 def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:

@@ -7,7 +7,7 @@ import math
 from simkit.importer.geometry import floats, origin, placed
 from simkit.importer.report import Report
 from simkit.importer.source import Source
-from simkit.spec.bounds import FIELD_BOUNDS
+from simkit.spec.bounds import FIELD_BOUNDS, TURNS
 
 TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating"}
 KNOWN = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
@@ -50,6 +50,14 @@ def joint_spec(source: Source, joint, report: Report, load: tuple[float, float])
     if math.sqrt(sum(a * a for a in axis)) < 1e-9:
         raise source.fail(axis_el, "joint axis must not be zero")
     spec["axis"] = list(axis)
+    if kind == "revolute" and _unbounded(joint):
+        kind = spec["type"] = "continuous"
+        report.changed(
+            source,
+            joint.find("limit"),
+            f"revolute limits beyond {TURNS} turns (a placeholder for none, e.g. a rotor): "
+            "imported as continuous",
+        )
     estimated: list[str] = []
     spec.update(_limits(source, joint, kind, report, load, estimated))
     dynamics = joint.find("dynamics")
@@ -135,6 +143,16 @@ def _limits(
         out["armature"] = armature
         estimated.append("armature")
     return out
+
+
+def _unbounded(joint) -> bool:
+    """A revolute joint whose lower or upper limit lies beyond TURNS turns (Iris's rotors
+    give +-1e16): the URDF's way of saying it has none."""
+    limit = joint.find("limit")
+    if limit is None:
+        return False
+    values = [_num(limit.get(key, "0")) for key in ("lower", "upper")]
+    return any(v is not None and abs(v) > TURNS * 2 * math.pi for v in values)
 
 
 def _num(text: str) -> float | None:

@@ -76,8 +76,18 @@ def closed_solid(mesh) -> tuple[np.ndarray, np.ndarray, str]:
     trimesh.repair.fix_normals(welded)
     if len(welded.faces) and _is_solid(welded.vertices, welded.faces):
         return np.asarray(welded.vertices), np.asarray(welded.faces), "welded"
-    hull = mesh.convex_hull
-    return np.asarray(hull.vertices), np.asarray(hull.faces), "hull"
+    return (*_hull(np.asarray(mesh.vertices)), "hull")
+
+
+def _hull(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The convex hull as a closed manifold at STL's float32 precision. manifold3d's hull,
+    not qhull's: on a thin part (Iris's propeller blades, 1 cm thick) qhull leaves sliver
+    facets that are not a manifold once written as float32."""
+    import manifold3d as mf
+
+    hull = mf.Manifold.hull_points(np.asarray(points, np.float32)).to_mesh()
+    vertices = np.array(hull.vert_properties, dtype=np.float64)[:, :3]
+    return vertices, np.array(hull.tri_verts, dtype=np.int64)
 
 
 class MeshWriter:

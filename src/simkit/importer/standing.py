@@ -2,8 +2,8 @@
 
 A URDF says nothing about it (the free joint is implicit), but simkit's floating joint has an
 origin that the legged checks drop the robot from. The importer puts the base so that the
-lowest point of any visual solid at the home pose touches the floor (z = 0); it is recorded
-as an estimate.
+lowest point of the collision geometry (the visual solid where a link collides with it) at
+the home pose touches the floor (z = 0); it is recorded as an estimate.
 """
 
 from __future__ import annotations
@@ -34,6 +34,17 @@ def _points(shape, base_dir: Path) -> np.ndarray:
     return local @ rpy_matrix(shape.rpy).T + np.asarray(shape.xyz)
 
 
+def floor_shapes(link) -> tuple:
+    """What of a link can touch the floor in the kit: its collision primitives or given
+    collision shapes where the spec has them (HyQ's shin is a 2 cm cylinder inside a wider
+    visual mesh), else its visual solid (whose hull or pieces the kit collides)."""
+    if link.collision_method == "primitives":
+        return link.collision_primitives
+    if link.collision_method == "given" and link.collision_shapes:
+        return link.collision_shapes
+    return link.shapes
+
+
 def standing_height(spec_path: Path) -> float | None:
     """Height (m) of the floating base's origin that puts the robot's lowest point at home on
     the floor; None when no link has a solid."""
@@ -49,8 +60,9 @@ def standing_height(spec_path: Path) -> float | None:
     home = dict(robot.poses).get("home")
     poses = forward(robot, home)
     lowest = None
+    touching = any(floor_shapes(link) for link in robot.links)
     for link in robot.links:
-        for shape in link.shapes:
+        for shape in floor_shapes(link) if touching else link.shapes:
             pts = _points(shape, spec_path.parent)
             world = pts @ poses[link.name][:3, :3].T + poses[link.name][:3, 3]
             z = float(world[:, 2].min())

@@ -1,0 +1,291 @@
+"""A home pose free of self-contact for a floating-base import, feet left where they are.
+
+The importer's first guess at `home` is 0 for every joint (mid-range where 0 is outside).
+Humanoids often hang their arms through their thighs at 0 (Talos's grippers sit 7 cm inside
+its thigh hulls), so the kit's servos would hold a pose its own links penetrate and the
+robot pushes itself over. This module measures self-contact with MuJoCo on the links'
+collision geometry as the spec gives it (primitives, the convex hull of each given collision
+mesh, else of each visual piece) with the kit's exclusions (links joined by a joint or welded
+by fixed joints), ignores pairs in contact in every sampled configuration (the kit excludes
+those, derive/collision_pairs.always_pairs), and moves one joint at a time to the value on a
+grid of its range that leaves the least penetration. Joints that carry a foot (a link whose
+lowest point at home is on the floor) stay put: the stance is the standing check's business.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+GRID = 8  # range divisions tried per joint
+SWEEPS = 2
+SAMPLES = 200  # random configurations that tell an always-touching pair
+FOOT = 0.01  # m: a link whose lowest point is this close to the robot's lowest is a foot
+SUPPORT = 0.003  # m: solid points this close to the lowest one touch the floor
+MARGIN = 0.01  # m: how far inside its support the CoM of a robot at rest must lie
+STABLE_SAMPLES = 2000  # random poses tried for one the robot rests on
+
+
+def _text(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+def _shapes(link) -> tuple:
+    return link.collision_primitives or link.collision_shapes or link.shapes
+
+
+def _geom(asset, body, shape, base_dir: Path, name: str) -> None:
+    from simkit.kitio.stl import from_stl
+    from simkit.model.kinematics import quat_wxyz, rpy_matrix
+
+    attrs = {"pos": _text(shape.xyz), "quat": _text(quat_wxyz(rpy_matrix(shape.rpy)))}
+    if shape.kind == "mesh":
+        vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
+        ET.SubElement(asset, "mesh", name=name, vertex=_text(vertices))
+        attrs.update(type="mesh", mesh=name)
+    elif shape.kind == "box":
+        attrs.update(type="box", size=_text(np.asarray(shape.size) / 2))
+    elif shape.kind == "sphere":
+        attrs.update(type="sphere", size=_text([shape.radius]))
+    else:  # cylinder, capsule; a cone as its bounding cylinder
+        radius = max(shape.radius, getattr(shape, "radius_top", None) or 0.0)
+        kind = "capsule" if shape.kind == "capsule" else "cylinder"
+        attrs.update(type=kind, size=_text([radius, shape.length / 2]))
+    ET.SubElement(body, "geom", attrs)
+
+
+def _model_xml(robot, base_dir: Path) -> str:
+    """Collision geometry only; every body but a fixed joint's child moves (fixed children
+    are welded, as MuJoCo does in the kit), the parent filter on."""
+    from simkit.model.kinematics import quat_wxyz, rpy_matrix
+
+    root = ET.Element("mujoco")
+    ET.SubElement(root, "compiler", angle="radian")
+    ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
+    asset = ET.SubElement(root, "asset")
+    bodies = {robot.root: ET.SubElement(root, "worldbody")}
+    for joint in robot.joints:
+        link = robot.link(joint.child)
+        quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
+        body = ET.SubElement(
+            bodies[joint.parent], "body", name=link.name, pos=_text(joint.xyz), quat=quat
+        )
+        bodies[link.name] = body
+        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
+        if kind:
+            ET.SubElement(body, "joint", name=joint.name, type=kind, axis=_text(joint.axis))
+        for i, shape in enumerate(_shapes(link)):
+            _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+    contact = ET.SubElement(root, "contact")
+    links = {link.name for link in robot.links}
+    for joint in robot.joints:
+        if joint.parent in links:
+            ET.SubElement(contact, "exclude", body1=joint.parent, body2=joint.child)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
+    """Deepest penetration (m, > 0) per touching body pair at `q`."""
+    import mujoco
+
+    data.qpos[adr] = q
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_collision(model, data)
+    out: dict[tuple[str, str], float] = {}
+    for contact in data.contact[: data.ncon]:
+        a = model.body(model.geom_bodyid[contact.geom1]).name
+        b = model.body(model.geom_bodyid[contact.geom2]).name
+        pair = (a, b) if a < b else (b, a)
+        out[pair] = max(out.get(pair, 0.0), -float(contact.dist))
+    return out
+
+
+def _feet_joints(robot, home, base_dir: Path) -> set[str]:
+    """Joints on the way from the base to any link whose lowest point at home is a foot."""
+    from simkit.importer.standing import _points, floor_shapes
+    from simkit.model.kinematics import forward
+
+    poses = forward(robot, home)
+    low: dict[str, float] = {}
+    for link in robot.links:
+        for shape in floor_shapes(link):
+            world = _points(shape, base_dir) @ poses[link.name][:3, :3].T
+            z = float((world[:, 2] + poses[link.name][2, 3]).min())
+            low[link.name] = min(low.get(link.name, math.inf), z)
+    if not low:
+        return set()
+    lowest = min(low.values())
+    parent = {j.child: j for j in robot.joints}
+    out: set[str] = set()
+    for name, z in low.items():
+        while z <= lowest + FOOT and name in parent:
+            out.add(parent[name].name)
+            name = parent[name].parent
+    return out
+
+
+def _chain(parent: dict, link: str) -> list:
+    """The joints from the root down to `link`."""
+    out = []
+    while link in parent:
+        out.append(parent[link])
+        link = parent[link].parent
+    return out
+
+
+class _Support:
+    """Where the robot touches a flat floor at a pose, and how far inside that support its
+    centre of mass lies (the geometry that touches the floor, as standing.py places it)."""
+
+    def __init__(self, robot, base_dir: Path):
+        from simkit.importer.standing import _points, floor_shapes
+
+        self.robot = robot
+        self.points = {
+            link.name: np.vstack([_points(shape, base_dir) for shape in floor_shapes(link)])
+            for link in robot.links
+            if floor_shapes(link)
+        }
+        parent = {j.child: j for j in robot.joints}
+        self.frame = {  # links no movable joint separates from the floating base
+            link.name
+            for link in robot.links
+            if all(j.type in ("fixed", "floating") for j in _chain(parent, link.name))
+        }
+        self.mass = {
+            link.name: (link.inertial.mass, np.asarray(link.inertial.com))
+            for link in robot.links
+            if link.inertial is not None
+        }
+
+    def margin(self, q, frame_only: bool = False) -> float:
+        """m the CoM's ground projection lies inside the convex hull of the lowest points
+        (within SUPPORT of the lowest); negative outside, or for a point or a line of
+        support (point feet side by side: it can only balance, never rest). `frame_only`:
+        -inf unless every lowest point is on the base or links welded to it (no servo
+        carries the weight)."""
+        from scipy.spatial import ConvexHull, QhullError
+
+        from simkit.model.kinematics import forward
+
+        poses = forward(self.robot, list(q))
+        world = [pts @ poses[n][:3, :3].T + poses[n][:3, 3] for n, pts in self.points.items()]
+        if not world or not self.mass:
+            return math.inf
+        every = np.vstack(world)
+        low = every[:, 2] <= every[:, 2].min() + SUPPORT
+        owners = np.repeat(list(self.points), [len(p) for p in self.points.values()])
+        if frame_only and not set(owners[low]) <= self.frame:
+            return -math.inf
+        feet = every[low][:, :2]
+        total = sum(m for m, _ in self.mass.values())
+        com = sum(m * (poses[n][:3, :3] @ c + poses[n][:3, 3]) for n, (m, c) in self.mass.items())
+        com = np.asarray(com)[:2] / total
+        try:
+            hull = ConvexHull(feet)
+        except (QhullError, ValueError):  # fewer than 3 points, or all on a line
+            return -float(np.min(np.linalg.norm(feet - com, axis=1))) - MARGIN
+        return float(np.min(-(hull.equations[:, :2] @ com + hull.equations[:, 2])))
+
+
+def _follow(q: np.ndarray, movable, index: dict[str, int]) -> np.ndarray:
+    """Rows of joint values with each mimic joint at its leader's (the kit's equality)."""
+    for j in movable:
+        if j.mimic is not None and j.mimic[0] in index:
+            leader, multiplier, offset = j.mimic
+            q[:, index[j.name]] = multiplier * q[:, index[leader]] + offset
+    return q
+
+
+def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
+    """The seeded random pose nearest `q` (joint-space distance) on which the robot rests
+    (CoM at least MARGIN inside its support) with no more self-contact than `q`, resting on
+    its frame alone where a draw allows (Hextilt's arm servos, 0.3 N m, cannot carry it);
+    `q` itself when none of them does. Random draws, not one joint at a time: a flying arm must move
+    two joints together to lift above its frame (Borinot)."""
+    free = depth(q)
+    lo, hi = np.array(limits, dtype=float).T
+    draws = lo + np.random.default_rng(0).random((STABLE_SAMPLES, len(movable))) * (hi - lo)
+    draws = _follow(draws, movable, index)
+    ordered = draws[np.argsort(np.linalg.norm(draws - q, axis=1), kind="stable")]
+    for frame_only in (True, False):  # on its frame if it can (a drone), else on its joints
+        for trial in ordered:
+            if support.margin(trial, frame_only) >= MARGIN and depth(trial) <= free + 1e-9:
+                return trial
+    return q
+
+
+def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
+    """A home pose (spec order) whose separable link pairs do not touch and on which the
+    robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
+    made (`joint: a -> b`); None when home already is, or no grid pose is better."""
+    import mujoco
+    import yaml
+
+    from simkit.model.resolve import resolve
+    from simkit.spec.schema import RobotSpec
+
+    text = spec_path.read_text(encoding="utf-8")
+    robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
+    home = dict(robot.poses).get("home")
+    if home is None:
+        return None
+    model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent))
+    data = mujoco.MjData(model)
+    movable = robot.movable_joints
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    limits = [(j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi) for j in movable]
+    index = {j.name: i for i, j in enumerate(movable)}
+    lo, hi = np.array(limits, dtype=float).T
+    draws = lo + np.random.default_rng(0).random((SAMPLES, len(movable))) * (hi - lo)
+    draws = _follow(draws, movable, index)
+    always: set | None = None
+    for q in draws:
+        touching = set(_contacts(model, data, adr, q))
+        always = touching if always is None else always & touching
+    always = always or set()
+
+    def depth(q) -> float:
+        return sum(d for p, d in _contacts(model, data, adr, q).items() if p not in always)
+
+    def search(q, score, done, frozen):
+        """Greedy: one joint at a time (distal first) to the grid value that most improves
+        `score(q)` (higher is better), until `done(best)`."""
+        best = score(q)
+        for _ in range(SWEEPS):
+            for j, (lo, hi) in reversed(list(zip(movable, limits, strict=True))):
+                if done(best):
+                    return q
+                if j.name in frozen or j.mimic is not None:
+                    continue
+                i = index[j.name]
+                grid = np.linspace(lo, hi, GRID + 1)[1:-1]  # not at a limit, where a servo rests
+                for value in sorted(grid, key=lambda v: abs(v - start[i])):
+                    trial = q.copy()
+                    trial[i] = value
+                    trial = _follow(trial[None, :], movable, index)[0]
+                    got = score(trial)
+                    if got > best + 1e-9:
+                        q, best = trial, got
+        return q
+
+    start = np.array(home, dtype=float)
+    q = start
+    if depth(q) > 0.0:
+        feet = _feet_joints(robot, home, spec_path.parent)
+        q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
+        if depth(q) > 0.0:
+            q = start
+    support = _Support(robot, spec_path.parent)
+    if support.margin(q) < MARGIN:
+        q = _resting(q, support, depth, movable, limits, index)
+    changes = [
+        f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
+        for i, j in enumerate(movable)
+        if abs(q[i] - start[i]) > 1e-12
+    ]
+    return ([float(f"{v:.6g}") for v in q], changes) if changes else None
