@@ -117,9 +117,10 @@ def import_robot(
         _step_budget(spec, stage, report, doc)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
-        _free_home(spec, report, doc, stage / f"{name}.yaml", path)
-        if floating:  # after the home pose is chosen: the robot stands on it
+        if floating:  # stance.py: out of self-contact with the feet kept, then stand
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
+        else:  # home.py: out of self-contact, any joint between touching links may move
+            _free_home(spec, report, doc, stage / f"{name}.yaml", path)
         writer.check(stage / f"{name}.yaml")
         for item in sorted(stage.rglob("*")):
             if item.is_file():

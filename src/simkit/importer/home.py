@@ -1,4 +1,4 @@
-"""A home pose free of self-contact for an import (fixed or floating base).
+"""A home pose free of self-contact for a fixed-base import (floating bases: stance.py).
 
 The importer's first guess at `home` is 0 for every joint (the middle of the range where 0
 is outside it). Many URDFs fold up at 0 (Panda's wrist, Z1's elbow, SO-100's jaw, PR2's arms
@@ -194,6 +194,8 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
 
     text = spec_path.read_text(encoding="utf-8")
     robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
+    if "home" not in dict(robot.poses):  # no movable joint: nothing to move
+        return None
     movable = robot.movable_joints
     start = np.array(dict(robot.poses)["home"], dtype=float)
     index = {j.name: i for i, j in enumerate(movable)}
