@@ -181,6 +181,15 @@ def _always_touching(robot, base_dir: Path, start: np.ndarray, follow) -> tuple:
     return tuple(sorted(tuple(sorted(p)) for p in pairs))
 
 
+def _within_limits(movable, q: np.ndarray) -> bool:
+    """Every joint of `q` (spec order) inside its limits (a mimic joint has its own)."""
+    return all(
+        (j.lower is None or value >= j.lower - 1e-9)
+        and (j.upper is None or value <= j.upper + 1e-9)
+        for j, value in zip(movable, q, strict=True)
+    )
+
+
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
     or None when the spec's home is already free or the search finds no free pose. Only the
@@ -227,6 +236,8 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
             grid = grid[(grid > lo + 1e-6) & (grid < hi - 1e-6)]
             for value in sorted(grid, key=lambda v: abs(v - start[i])):
                 trial = follow(np.where(np.arange(len(q)) == i, value, q))
+                if not _within_limits(movable, trial):  # a mimic follower left its range
+                    continue
                 depth, found = _penetration(model, data, adr, trial)
                 if depth < best - 1e-9:
                     q, best, pairs, moved = trial, depth, found, True
