@@ -55,3 +55,37 @@ def test_close_stops_an_unwanted_child() -> None:
     assert job._pid == 0
     with pytest.raises(ChildProcessError):
         os.waitpid(pid, os.WNOHANG)
+
+
+def _pid_and_json_loaded() -> tuple[int, bool]:
+    import sys
+
+    return os.getpid(), "json.decoder" in sys.modules
+
+
+def _fails() -> int:
+    raise RuntimeError("bad solid")
+
+
+def test_warm_worker_runs_jobs_in_one_child_that_imported_first() -> None:
+    from simkit.kitio import forked
+
+    with forked.warm_worker(("json",)):
+        first = Background(_pid_and_json_loaded).result()
+        second = Background(_pid_and_json_loaded).result()
+        assert forked._WORKER is not None and forked._WORKER.pid == first[0]
+    assert first[0] == second[0] != os.getpid()  # one worker, not this process
+    assert first[1]  # the worker imported json before the job came
+    assert forked._WORKER is None
+
+
+def test_warm_worker_failure_is_raised_here_and_unpicklable_work_forks() -> None:
+    from simkit.kitio import forked
+
+    with forked.warm_worker(("json",)):
+        with pytest.raises(RuntimeError, match="bad solid"):
+            Background(_fails).result()
+        local = 7
+        job = Background(lambda: local * 6)  # a lambda cannot be pickled: a fresh fork runs it
+        assert job._worker is None and job._pid > 0
+        assert job.result() == 42

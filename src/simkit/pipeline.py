@@ -18,9 +18,18 @@ from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.errors import CheckFailed, SpecError, UnknownRobot
-from simkit.kitio import atomic, layout
+from simkit.kitio import atomic, forked, layout
 from simkit.kitio.archive import zip_bytes
-from simkit.kitio.cache import Arrays, Cache, cached_stage, decode_json, digest, encode_json
+from simkit.kitio.cache import (
+    Arrays,
+    Cache,
+    cached_stage,
+    code_digest,
+    decode_json,
+    digest,
+    encode_json,
+    make_key,
+)
 from simkit.kitio.resources import data_dir, robot_names
 from simkit.model.resolve import resolve
 from simkit.model.robot import Robot
@@ -204,9 +213,46 @@ def build(
 ) -> BuildResult:
     """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`;
     `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`; `step`: False leaves
-    out `step/NAME.step` (and the Open CASCADE import it costs)."""
-    say = progress or (lambda _msg: None)
+    out `step/NAME.step` (and the Open CASCADE import it costs).
+
+    A build of a spec this code has not built before starts a warm worker at once, which
+    imports Open CASCADE while the model is derived and then writes and checks the STEP
+    (kitio/forked.py); a rebuild does not, as its STEP comes from the cache."""
     cache = Cache.at() if cache is None else cache
+    hint = _rebuild_hint(target, cache, usd_format, step)
+    cold = step and (hint is None or cache.get("built", hint) is None)
+    with forked.warm_worker(("OCP",) if cold else ()):
+        result = _build(target, out_dir, check, progress, cache, jobs, usd_format, step)
+    if hint is not None and cold and cache.enabled:
+        import numpy as np
+
+        cache.put("built", hint, {"built": np.ones(1, dtype=np.uint8)})
+    return result
+
+
+def _rebuild_hint(target: str, cache: Cache, usd_format: str, step: bool) -> str | None:
+    """Cache key of "this spec file was built by this code with these options" (a hint
+    only: a mesh file the spec uses may have changed), or None without a readable spec."""
+    try:
+        data = find_spec(target)[0].read_bytes()
+    except (OSError, UnknownRobot):
+        return None
+    params = {"usd_format": usd_format, "step": step}
+    return make_key("built", 1, [code_digest().encode(), data], params, ())
+
+
+def _build(
+    target: str,
+    out_dir: Path,
+    check: bool,
+    progress: Progress | None,
+    cache: Cache,
+    jobs: int | None,
+    usd_format: str,
+    step: bool,
+) -> BuildResult:
+    """`build` after the warm worker is settled."""
+    say = progress or (lambda _msg: None)
     robot = model_from_spec(target, progress, cache, jobs)
     step = step and robot.step  # the spec can leave the STEP out too
     say("emit")
