@@ -189,7 +189,9 @@ def first_contacts(
 
 def welded_pairs(robot: Robot) -> set[tuple[str, str]]:
     """Link pairs whose contacts MuJoCo filters in the kit's MJCF by itself: bodies welded
-    together by fixed joints, and a welded group with its parent group (the parent filter)."""
+    together by fixed joints, and a welded group with its parent group (the parent filter),
+    except where the parent group is welded to the world: MuJoCo's parent filter skips the
+    world body (Baxter's head turns inside spheres fixed to its base, which do collide)."""
     parent = {j.child: j for j in robot.joints}
 
     def weld(link: str) -> str:
@@ -198,7 +200,9 @@ def welded_pairs(robot: Robot) -> set[tuple[str, str]]:
         return link
 
     groups = {link.name: weld(link.name) for link in robot.links}
+    world = weld(robot.root)  # the root's group: welded to MuJoCo's world body
     up = {g: weld(parent[g].parent) for g in set(groups.values()) if g in parent}
+    up = {g: p for g, p in up.items() if p != world}
     out = set()
     for a, b in itertools.combinations(sorted(groups), 2):
         ga, gb = groups[a], groups[b]
