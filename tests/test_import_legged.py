@@ -94,7 +94,9 @@ def test_always_touching_pairs_are_found(tmp_path):
     robot = resolve(spec, text.encode(), done.spec_path.name)
     q = configurations(robot, 0, 200)
     assert always_pairs(robot, q) == [("body", "thigh")]
-    assert ("body", "hip") in welded_pairs(robot)  # parent and child: MuJoCo's own filter
+    # body is welded to the world: MuJoCo's parent filter skips the world, so body and hip
+    # do collide unless excluded (the kit excludes them as a jointed pair)
+    assert ("body", "hip") not in welded_pairs(robot)
 
 
 def test_floating_urdf_without_collision_collides_with_its_visuals(tmp_path):
@@ -224,3 +226,25 @@ def test_flying_arm_rests_on_its_frame(tmp_path):
     assert support.margin([0.0, 0.0]) < MARGIN  # the first guess stands on the arm's tip
     home = spec.poses["home"]
     assert home != (0.0, 0.0) and support.margin(home, frame_only=True) >= MARGIN
+
+
+def test_mujoco_parent_filter_skips_a_world_welded_parent():
+    """The fact welded_pairs relies on: a jointed child touches its world-welded parent, but
+    not its parent on a free joint."""
+    import mujoco
+
+    xml = """<mujoco><worldbody>
+    <body name="fixed"><geom type="box" size=".2 .2 .2"/>
+      <body name="a"><joint type="hinge"/><geom type="box" size=".1 .1 .1" pos="0 0 .1"/></body>
+    </body>
+    <body name="free" pos="2 0 0"><freejoint/><geom type="box" size=".2 .2 .2"/>
+      <body name="b"><joint type="hinge"/><geom type="box" size=".1 .1 .1" pos="0 0 .1"/></body>
+    </body></worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    pairs = {
+        (model.body(model.geom_bodyid[g1]).name, model.body(model.geom_bodyid[g2]).name)
+        for g1, g2 in data.contact.geom[: data.ncon]
+    }
+    assert pairs == {("fixed", "a")}
