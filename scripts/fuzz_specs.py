@@ -190,13 +190,19 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -
         stats.setdefault("build_refusals", []).append(proc.stderr.strip().splitlines()[-1][:300])
         return "build_refused"
     kits = [p for p in out.iterdir() if p.name.endswith("_description")]
-    check = subprocess.run(
-        [sys.executable, "-m", "simkit.cli", "check", str(kits[0])],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=env,
-    )
+    try:
+        check = subprocess.run(
+            [sys.executable, "-m", "simkit.cli", "check", str(kits[0])],
+            capture_output=True,
+            text=True,
+            timeout=3 * WALL_BACKSTOP_S,  # a starved (niced) check is slow, not hung
+            env=env,
+            preexec_fn=_limit_cpu,
+        )
+    except subprocess.TimeoutExpired:
+        return "over_60s"
+    if check.returncode in (-signal.SIGXCPU, -signal.SIGKILL):
+        return "over_60s"
     return "built_ok" if check.returncode == 0 else "check_rejects_exit0_kit"
 
 
