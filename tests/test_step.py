@@ -219,3 +219,31 @@ def test_no_step_build_leaves_the_file_out_and_still_passes(tmp_path):
     assert doc["geometry"]["step"] is None
     assert all(f.ok for f in result.findings)
     assert "step.file" in {f.check for f in result.findings}
+
+
+def test_near_duplicate_vertices_are_welded_into_a_valid_solid():
+    """A CAD mesh whose corner appears twice, 1e-13 m apart (shorter than Open CASCADE's edge
+    tolerance): welded, it is a valid solid with the mesh's volume."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    from simkit.model.robot import Mesh
+
+    box = to_mesh(mf.Manifold.cube((0.1, 0.1, 0.1), center=True))
+    vertices = np.vstack([box.vertices, box.vertices[:1] + 1e-13])
+    faces = np.array(box.faces)
+    first = np.nonzero((faces == 0).any(axis=1))[0][0]
+    faces[first][faces[first] == 0] = len(vertices) - 1  # one triangle uses the twin
+    solid = brep.faceted_solid(Mesh.of(vertices, faces))
+    assert BRepCheck_Analyzer(solid).IsValid()
+    assert step_reader.volume(solid) == pytest.approx(1e6, rel=1e-9)  # mm^3
+
+
+def test_sphere_mesh_holds_within_the_step_checks_one_percent():
+    from simkit.derive.solids import primitive_solid
+
+    sphere = _shape("sphere", radius=0.05)
+    mesh = to_mesh(primitive_solid(sphere))
+    exact = step_reader.volume(brep.primitive_shape(sphere))
+    tri = mesh.vertices[mesh.faces]
+    meshed = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6 * 1e9
+    assert 0 < 1 - meshed / exact < 0.005

@@ -171,6 +171,29 @@ def mesh_solid(mesh: Mesh) -> TopoDS_Shape:
     return compound
 
 
+#: mm: vertices closer than this are one (Open CASCADE cannot make an edge shorter than its
+#: 1e-7 mm tolerance; CAD meshes carry such near-duplicates)
+WELD_MM = 1e-4
+
+
+def _welded(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's used vertices (mm) with near-duplicates merged, and its triangles (0-based)
+    without the ones that merging collapsed."""
+    faces = np.asarray(mesh.faces, dtype=int)
+    used, local = np.unique(faces.ravel(), return_inverse=True)
+    points = np.asarray(mesh.vertices, dtype=float)[used] * MM
+    _, first, merged = np.unique(
+        np.round(points / WELD_MM), axis=0, return_index=True, return_inverse=True
+    )
+    triangles = merged.ravel()[local].reshape(-1, 3)
+    keep = (
+        (triangles[:, 0] != triangles[:, 1])
+        & (triangles[:, 1] != triangles[:, 2])
+        & (triangles[:, 0] != triangles[:, 2])
+    )
+    return points[first], triangles[keep]
+
+
 def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
     """A closed, connected triangle mesh (m, outward winding) as one faceted solid (mm).
 
@@ -187,22 +210,63 @@ def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
-    used, local = np.unique(np.asarray(mesh.faces, dtype=int).ravel(), return_inverse=True)
-    triangles = local.reshape(-1, 3) + 1  # Poly_Triangulation counts from 1
-    nodes = np.asarray(mesh.vertices, dtype=float)[used] * MM
+    nodes, triangles = _welded(mesh)
+    triangles = triangles + 1  # Poly_Triangulation counts from 1
     triangulation = Poly_Triangulation(len(nodes), len(triangles), False)
     for i, (x, y, z) in enumerate(nodes.tolist(), 1):
         triangulation.SetNode(i, gp_Pnt(x, y, z))
     for i, (a, b, c) in enumerate(triangles.tolist(), 1):
         triangulation.SetTriangle(i, Poly_Triangle(a, b, c))
-    faces = BRepBuilderAPI_MakeShapeOnMesh(triangulation).Shape()
+    maker = BRepBuilderAPI_MakeShapeOnMesh(triangulation)
+    try:
+        maker.Build()
+    except Exception:  # StdFail_NotDone, e.g. on a zero-area sliver, which has no plane
+        return _faceted_solid_by_face(nodes, triangles - 1)
+    if not maker.IsDone():
+        return _faceted_solid_by_face(nodes, triangles - 1)
     builder = BRep_Builder()
     shell = TopoDS_Shell()
     builder.MakeShell(shell)
-    explorer = TopExp_Explorer(faces, TopAbs_FACE)
+    explorer = TopExp_Explorer(maker.Shape(), TopAbs_FACE)
     while explorer.More():
         builder.Add(shell, explorer.Current())
         explorer.Next()
+    shell.Closed(True)
+    solid = TopoDS_Solid()
+    builder.MakeSolid(solid)
+    builder.Add(solid, shell)
+    return solid
+
+
+def _faceted_solid_by_face(nodes: np.ndarray, triangles: np.ndarray) -> TopoDS_Shape:
+    """`faceted_solid` built face by face (mm nodes, 0-based triangles), for a mesh that
+    OCCT's mesh builder refuses: a zero-area sliver gets no face, its edges are shared by its
+    neighbours already. About ten times slower."""
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace as MakeFace
+    from OCP.gp import gp_Dir, gp_Pln, gp_Pnt
+    from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid, TopoDS_Wire
+
+    points = [BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, v))).Vertex() for v in nodes]
+    edges: dict[tuple[int, int], Any] = {}
+    builder = BRep_Builder()
+    shell = TopoDS_Shell()
+    builder.MakeShell(shell)
+    for tri in triangles.tolist():
+        a, b, c = nodes[tri]
+        normal = np.cross(b - a, c - a)
+        wire = TopoDS_Wire()
+        builder.MakeWire(wire)
+        for i, j in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
+            key = (min(i, j), max(i, j))
+            if key not in edges:
+                edges[key] = BRepBuilderAPI_MakeEdge(points[key[0]], points[key[1]]).Edge()
+            builder.Add(wire, edges[key] if i < j else edges[key].Reversed())
+        if np.linalg.norm(normal) <= 1e-12:
+            continue
+        plane = gp_Pln(gp_Pnt(*map(float, a)), gp_Dir(*map(float, normal)))
+        builder.Add(shell, MakeFace(plane, wire, True).Face())
     shell.Closed(True)
     solid = TopoDS_Solid()
     builder.MakeSolid(solid)

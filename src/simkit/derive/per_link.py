@@ -42,7 +42,7 @@ def default_jobs() -> int:
 def _solid_key(link: Link, base_dir: Path) -> str:
     from dataclasses import asdict
 
-    from simkit.derive.solids import CIRCULAR_SEGMENTS
+    from simkit.derive.solids import CIRCULAR_SEGMENTS, SPHERE_SEGMENTS
 
     inputs = []
     for shape in link.shapes:
@@ -52,7 +52,11 @@ def _solid_key(link: Link, base_dir: Path) -> str:
                 path.read_bytes() if path.is_file() else b"missing:" + shape.file.encode()
             )
     libraries = ("manifold3d", "trimesh") if inputs else ("manifold3d",)
-    params = {"shapes": [asdict(s) for s in link.shapes], "segments": CIRCULAR_SEGMENTS}
+    params = {
+        "shapes": [asdict(s) for s in link.shapes],
+        "segments": CIRCULAR_SEGMENTS,
+        "sphere_segments": SPHERE_SEGMENTS,
+    }
     return make_key(SOLID_STEP, SOLID_VERSION, inputs, params, libraries)
 
 

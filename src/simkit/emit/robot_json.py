@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from simkit import __version__
-from simkit.derive.solids import CIRCULAR_SEGMENTS
+from simkit.derive.solids import CIRCULAR_SEGMENTS, SPHERE_SEGMENTS
 from simkit.emit import mjcf_world
 from simkit.emit.step import step_origin
 from simkit.kitio import layout
@@ -164,7 +164,7 @@ def document(robot: Robot, reports: SimReports) -> dict:
         "mass": {"published": published.get("mass"), "model": robot.total_mass},
         "geometry": {
             "method": "each link is one filled solid: the union of the spec's primitives "
-            f"(manifold3d, {CIRCULAR_SEGMENTS} segments per circle); motors and gearboxes are "
+            f"(manifold3d, {_segments(robot)} per circle); motors and gearboxes are "
             "plain envelopes",
             "mass_properties": "CoM and inertia of the solid at uniform density scaled to the "
             "link mass, unless the spec gives them",
@@ -263,6 +263,15 @@ def _generalise(robot: Robot, doc: dict) -> None:
         doc["sensors"] = [s.model_dump(exclude_none=True) for s in robot.mjcf.sensors]
 
 
+def _segments(robot: Robot) -> str:
+    """How finely the meshes are tessellated, in words (spheres only where the robot has one,
+    so a kit without spheres reads as before)."""
+    text = f"{CIRCULAR_SEGMENTS} segments"
+    if any(s.kind == "sphere" for link in robot.links for s in link.shapes):
+        text += f" ({SPHERE_SEGMENTS} for spheres)"
+    return text
+
+
 def step_geometry(robot: Robot) -> dict:
     """robot.json `geometry.step`: where the STEP assembly is and how it relates to the meshes."""
     return {
@@ -273,7 +282,7 @@ def step_geometry(robot: Robot) -> dict:
         "relation": "the same primitives as the visual meshes, as exact B-rep solids (true "
         "cylinders, cones and spheres; Open CASCADE): one product per link, named as the link, "
         "placed at the zero pose; the meshes are those solids tessellated with "
-        f"{CIRCULAR_SEGMENTS} segments per circle, so they hold a little less volume (under "
+        f"{_segments(robot)} per circle, so they hold a little less volume (under "
         "1 %); a link from a mesh file is the sewn faceted mesh",
     }
 
