@@ -1,6 +1,7 @@
 """Import and build every URDF of example-robot-data (issue 15); print and save the table.
 
     python scripts/import_corpus.py [--only SUBSTR ...] [--timeout S] [--hull] [--out DIR]
+    python scripts/import_corpus.py --rerun --only SUBSTR ...   # after a fix: replace rows
 
 Each robot: `simkit import` (with `--hull` if asked), a cold build with an empty cache,
 then a warm build with the same cache. Writes docs/import-corpus.md. Runs one build at a time.
@@ -134,25 +135,42 @@ def main() -> None:
     parser.add_argument("--hull", action="store_true", help="import with --hull")
     parser.add_argument("--out", type=Path, default=Path("/tmp/simkit-corpus"))
     parser.add_argument("--md", type=Path, default=REPO / "docs" / "import-corpus.md")
+    parser.add_argument(
+        "--rerun",
+        action="store_true",
+        help="with --only: rerun these robots and replace their rows in OUT/rows.json (the "
+        "last full run), then rewrite the table",
+    )
     args = parser.parse_args()
     root = corpus()
     # the largest robots first (issue 15's performance targets), then the rest by path
     urdfs = sorted(root.rglob("*.urdf"), key=lambda p: (not p.name.startswith(BIG), str(p)))
     if args.only:
         urdfs = [p for p in urdfs if any(s in str(p.relative_to(root)) for s in args.only)]
+    saved = args.out / "rows.json"
+    earlier = json.loads(saved.read_text()) if args.rerun and saved.is_file() else []
     rows = []
     for urdf in urdfs:
         row = one(urdf, root, args.out, args.timeout, args.hull)
         rows.append(row)
         print(f"{row['robot']}: import {row['import']}, build {row['build']} {row['failing']} "
               f"cold {row['cold']} warm {row['warm']}", flush=True)  # fmt: skip
-        _save(args.md, rows, len(urdfs))
+        if not args.rerun:
+            _save(args.md, rows, len(urdfs))
+            saved.write_text(json.dumps(rows, indent=1))
+    if args.rerun:  # the rows of the last full run, these robots replaced
+        fresh = {r["robot"]: r for r in rows}
+        rows = [fresh.get(r["robot"], r) for r in earlier]
+        saved.write_text(json.dumps(rows, indent=1))
+        _save(args.md, rows, len(rows), rerun=sorted(fresh))
     print(table(rows))
 
 
-def _save(md: Path, rows: list[dict], total: int) -> None:
+def _save(md: Path, rows: list[dict], total: int, rerun: list[str] = ()) -> None:
     """Write the table so far (a long run leaves a partial table if stopped)."""
     done = "" if len(rows) == total else f" (partial: {len(rows)} of {total} URDFs run)"
+    if rerun:
+        done += f"; then `--rerun --only` for {len(rerun)} robots after fixes: {', '.join(rerun)}"
     md.write_text(
         "# Import corpus: example-robot-data 6.0.0\n\n"
         "Made by `python scripts/import_corpus.py "
