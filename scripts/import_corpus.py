@@ -170,7 +170,10 @@ def _save(md: Path, rows: list[dict], total: int, rerun: list[str] = ()) -> None
     """Write the table so far (a long run leaves a partial table if stopped)."""
     done = "" if len(rows) == total else f" (partial: {len(rows)} of {total} URDFs run)"
     if rerun:
-        done += f"; then `--rerun --only` for {len(rerun)} robots after fixes: {', '.join(rerun)}"
+        done = (
+            " (rows of the last full run, saved in OUT/rows.json, with these robots rerun "
+            f"after fixes: {', '.join(rerun)})"
+        )
     md.write_text(
         "# Import corpus: example-robot-data 6.0.0\n\n"
         "Made by `python scripts/import_corpus.py "
