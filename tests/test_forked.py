@@ -3,10 +3,28 @@
 from __future__ import annotations
 
 import os
+import sys
 
 import pytest
 
 from simkit.kitio.forked import Background
+
+
+#: JAX (if an earlier test loaded it) warns at every fork; these forks run only simkit code
+pytestmark = pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")
+
+
+@pytest.fixture(autouse=True)
+def _no_jax(monkeypatch: pytest.MonkeyPatch) -> None:
+    """An earlier test (test_asimov's MJX check) may have loaded JAX, which turns forking
+    off; these tests are about forking, so they hide it (its threads are idle by now)."""
+    monkeypatch.delitem(sys.modules, "jax", raising=False)
+
+
+def test_no_fork_where_jax_is_loaded(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "jax", object())
+    job = Background(os.getpid)
+    assert job._pid == 0 and job.result() == os.getpid()
 
 
 def test_child_value_comes_back_and_child_is_reaped() -> None:

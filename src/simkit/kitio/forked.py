@@ -30,7 +30,15 @@ T = TypeVar("T")
 
 
 def _can_fork() -> bool:
-    return hasattr(os, "fork") and os.environ.get("SIMKIT_NO_FORK", "") not in ("1", "true")
+    """Fork only where it is safe: not where JAX is loaded (its thread pool can deadlock a
+    forked child; MJX users import it, simkit itself never does)."""
+    import sys
+
+    return (
+        hasattr(os, "fork")
+        and os.environ.get("SIMKIT_NO_FORK", "") not in ("1", "true")
+        and "jax" not in sys.modules
+    )
 
 
 class Background(Generic[T]):
