@@ -9,7 +9,6 @@ import pytest
 
 from simkit.kitio.forked import Background
 
-
 #: JAX (if an earlier test loaded it) warns at every fork; these forks run only simkit code
 pytestmark = pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")
 
