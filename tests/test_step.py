@@ -247,3 +247,16 @@ def test_sphere_mesh_holds_within_the_step_checks_one_percent():
     tri = mesh.vertices[mesh.faces]
     meshed = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6 * 1e9
     assert 0 < 1 - meshed / exact < 0.005
+
+
+def test_a_cavity_is_an_inner_shell_of_its_solid():
+    """A hollow block: the cavity's inward-facing piece becomes the solid's inner shell, not a
+    solid of negative volume (which a STEP reader drops)."""
+    from OCP.BRepCheck import BRepCheck_Analyzer
+
+    block = mf.Manifold.cube((0.1, 0.1, 0.1), center=True)
+    hollow = to_mesh(block - mf.Manifold.cube((0.04, 0.04, 0.04), center=True))
+    solids = step_reader.solids_of(brep.link_shape(_link([_shape("mesh", file="x.stl")], hollow)))
+    assert len(solids) == 1
+    assert BRepCheck_Analyzer(solids[0]).IsValid()
+    assert step_reader.volume(solids[0]) == pytest.approx(100**3 - 40**3, rel=1e-9)
