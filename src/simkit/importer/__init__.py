@@ -68,20 +68,22 @@ def robot_name(path: Path) -> str:
 
 
 def _free_home(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
-    """Move `home` out of self-contact (home.py) and rewrite the spec, reporting the change."""
-    from simkit.importer import home, writer
+    """Move a fixed-base robot's `home` out of self-contact (home.py); rewrite the spec."""
+    from simkit.importer import home
 
-    found = home.free_home(spec_path)
+    why = "the links collide at the first guess (0, or mid-range outside the limits)"
+    _new_home(home.free_home(spec_path), why, spec, report, doc, spec_path, path)
+
+
+def _new_home(found, why: str, spec: dict, report: Report, doc, spec_path: Path, path: Path):
+    """Record a searched `home` (`found`: (pose, changes) or None) with one report line and
+    rewrite the spec."""
+    from simkit.importer import writer
+
     if found is None:
         return
     spec["poses"]["home"], changes = found
-    report.assumed(
-        doc,
-        doc.root,
-        "home: the links collide at the first guess (0, or mid-range outside the limits); "
-        + ", ".join(changes)
-        + " rad or m",
-    )
+    report.assumed(doc, doc.root, f"home: {why}; " + ", ".join(changes) + " rad or m")
     spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
 
 
@@ -134,17 +136,11 @@ def import_robot(
 
 def _free_stance(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
     """Move a floating robot's `home` out of self-contact, feet kept (stance.py); rewrite the
-    spec, reporting the change."""
-    from simkit.importer import stance, writer
+    spec."""
+    from simkit.importer import stance
 
-    found = stance.free_home(spec_path)
-    if found is None:
-        return
-    spec["poses"]["home"], changes = found
-    report.assumed(
-        doc,
-        doc.root,
-        "home: at the first guess (0, or mid-range outside the limits) links collide or the "
-        "robot cannot rest on the floor; " + ", ".join(changes) + " rad or m",
+    why = (
+        "at the first guess (0, or mid-range outside the limits) links collide or the robot "
+        "cannot rest on the floor"
     )
-    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
+    _new_home(stance.free_home(spec_path), why, spec, report, doc, spec_path, path)

@@ -82,16 +82,12 @@ def _adjacent(robot) -> set[tuple[str, str]]:
     return {tuple(sorted((a, b))) for a in solid for b in near.get(a, ()) if b in solid}
 
 
-def _model_xml(robot, base_dir: Path, also_excluded: tuple = ()) -> str:
+def add_bodies(root: ET.Element, robot, base_dir: Path, shapes_of, geom) -> None:
+    """The robot's body tree under `root`'s worldbody (unit masses; hinge or slide joints),
+    each link with a geom per shape `shapes_of(link)` gives, written by `geom`: the
+    collision-only MuJoCo model the home (here) and stance (stance.py) searches use."""
     from simkit.model.kinematics import quat_wxyz, rpy_matrix
 
-    root = ET.Element("mujoco")
-    ET.SubElement(root, "compiler", angle="radian")
-    ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable")
-    margin = _text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
-    ET.SubElement(
-        ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
-    )
     asset = ET.SubElement(root, "asset")
     bodies = {robot.root: ET.SubElement(root, "worldbody")}
     for joint in robot.joints:
@@ -105,8 +101,20 @@ def _model_xml(robot, base_dir: Path, also_excluded: tuple = ()) -> str:
         kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
         if kind:
             ET.SubElement(body, "joint", name=joint.name, type=kind, axis=_text(joint.axis))
-        for i, shape in enumerate(_shapes(link)):
-            _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+        for i, shape in enumerate(shapes_of(link)):
+            geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+
+
+def _model_xml(robot, base_dir: Path, also_excluded: tuple = ()) -> str:
+
+    root = ET.Element("mujoco")
+    ET.SubElement(root, "compiler", angle="radian")
+    ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable")
+    margin = _text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
+    ET.SubElement(
+        ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
+    )
+    add_bodies(root, robot, base_dir, _shapes, _geom)
     contact = ET.SubElement(root, "contact")
     for a, b in sorted(_adjacent(robot) | set(also_excluded)):
         ET.SubElement(contact, "exclude", body1=a, body2=b)

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.importer.home import _geom  # one collision-model writer for both searches
+
 GRID = 8  # range divisions tried per joint
 SWEEPS = 2
 SAMPLES = 200  # random configurations that tell an always-touching pair
@@ -29,57 +31,19 @@ MARGIN = 0.01  # m: how far inside its support the CoM of a robot at rest must l
 STABLE_SAMPLES = 2000  # random poses tried for one the robot rests on
 
 
-def _text(values) -> str:
-    return " ".join(repr(float(v)) for v in np.ravel(values))
-
-
 def _shapes(link) -> tuple:
     return link.collision_primitives or link.collision_shapes or link.shapes
-
-
-def _geom(asset, body, shape, base_dir: Path, name: str) -> None:
-    from simkit.kitio.stl import from_stl
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
-
-    attrs = {"pos": _text(shape.xyz), "quat": _text(quat_wxyz(rpy_matrix(shape.rpy)))}
-    if shape.kind == "mesh":
-        vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
-        ET.SubElement(asset, "mesh", name=name, vertex=_text(vertices))
-        attrs.update(type="mesh", mesh=name)
-    elif shape.kind == "box":
-        attrs.update(type="box", size=_text(np.asarray(shape.size) / 2))
-    elif shape.kind == "sphere":
-        attrs.update(type="sphere", size=_text([shape.radius]))
-    else:  # cylinder, capsule; a cone as its bounding cylinder
-        radius = max(shape.radius, getattr(shape, "radius_top", None) or 0.0)
-        kind = "capsule" if shape.kind == "capsule" else "cylinder"
-        attrs.update(type=kind, size=_text([radius, shape.length / 2]))
-    ET.SubElement(body, "geom", attrs)
 
 
 def _model_xml(robot, base_dir: Path) -> str:
     """Collision geometry only; every body but a fixed joint's child moves (fixed children
     are welded, as MuJoCo does in the kit), the parent filter on."""
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
+    from simkit.importer.home import add_bodies
 
     root = ET.Element("mujoco")
     ET.SubElement(root, "compiler", angle="radian")
     ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
-    asset = ET.SubElement(root, "asset")
-    bodies = {robot.root: ET.SubElement(root, "worldbody")}
-    for joint in robot.joints:
-        link = robot.link(joint.child)
-        quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
-        body = ET.SubElement(
-            bodies[joint.parent], "body", name=link.name, pos=_text(joint.xyz), quat=quat
-        )
-        bodies[link.name] = body
-        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
-        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
-        if kind:
-            ET.SubElement(body, "joint", name=joint.name, type=kind, axis=_text(joint.axis))
-        for i, shape in enumerate(_shapes(link)):
-            _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+    add_bodies(root, robot, base_dir, _shapes, _geom)
     contact = ET.SubElement(root, "contact")
     links = {link.name for link in robot.links}
     for joint in robot.joints:
