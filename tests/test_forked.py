@@ -106,3 +106,12 @@ def test_warm_worker_failure_is_raised_here_and_unpicklable_work_forks() -> None
         job = Background(lambda: local * 6)  # a lambda cannot be pickled: a fresh fork runs it
         assert job._worker is None and job._pid > 0
         assert job.result() == 42
+
+
+def test_run_all_keeps_job_order_and_runs_the_named_jobs_beside() -> None:
+    from simkit.kitio.forked import run_all
+
+    jobs = {"a": os.getpid, "b": _pid_and_json_loaded, "c": os.getpid}
+    done = run_all(jobs, ("b",))
+    assert list(done) == ["a", "b", "c"]
+    assert done["a"] == done["c"] == os.getpid() != done["b"][0]  # b ran in a child

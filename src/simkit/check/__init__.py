@@ -25,7 +25,7 @@ from simkit.check.step import check_step
 from simkit.check.urdf import check_urdf
 from simkit.check.usd import check_usd
 from simkit.kitio.cache import Cache, cached_stage, decode_json, encode_json
-from simkit.kitio.forked import Background
+from simkit.kitio.forked import run_all
 
 Check = Callable[[Kit], list[Finding]]
 
@@ -52,17 +52,8 @@ def run_checks(kit_dir: Path, checks: dict[str, Check] | None = None) -> list[Fi
     """Every finding for the kit at `kit_dir`, in a stable order."""
     kit = Kit.open(kit_dir)
     checks = checks or CHECKS
-    background = {
-        name: Background(partial(_guarded, name, checks[name], kit))
-        for name in BACKGROUND
-        if name in checks
-    }
-    try:
-        found = {n: _guarded(n, c, kit) for n, c in checks.items() if n not in background}
-        found.update({name: job.result() for name, job in background.items()})
-    finally:
-        for job in background.values():
-            job.close()
+    jobs = {name: partial(_guarded, name, check, kit) for name, check in checks.items()}
+    found = run_all(jobs, BACKGROUND)
     return [finding for name in checks for finding in found[name]]
 
 

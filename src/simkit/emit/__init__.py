@@ -25,7 +25,7 @@ from simkit.emit import (
     urdf,
     usd,
 )
-from simkit.kitio.forked import Background
+from simkit.kitio.forked import run_all
 from simkit.model.robot import Robot, SimReports
 
 Emitter = Callable[[Robot], dict[str, bytes]]
@@ -55,16 +55,8 @@ BACKGROUND = ("step",)
 def emit_all(robot: Robot, emitters: dict[str, Emitter] | None = None) -> dict[str, bytes]:
     """Run every model emitter (before the simulate stage)."""
     emitters = emitters or EMITTERS
-    background = {
-        name: Background(partial(emitters[name], robot)) for name in BACKGROUND if name in emitters
-    }
-    try:
-        outputs = {n: e(robot) for n, e in emitters.items() if n not in background}
-        outputs.update({name: job.result() for name, job in background.items()})
-    finally:
-        for job in background.values():
-            job.close()
-    return _collect({name: outputs[name] for name in emitters})
+    jobs = {name: partial(emitter, robot) for name, emitter in emitters.items()}
+    return _collect(run_all(jobs, BACKGROUND))
 
 
 def emit_reports(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, bytes]:

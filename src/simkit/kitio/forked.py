@@ -118,6 +118,20 @@ def _child(work: Callable[[], object], write_fd: int) -> None:
         os._exit(0)
 
 
+def run_all(jobs: dict[str, Callable[[], T]], beside: tuple[str, ...]) -> dict[str, T]:
+    """Every job's value, by name (in `jobs` order). The jobs named in `beside` start first as
+    `Background` work (keep them picklable, e.g. a `functools.partial` of module functions,
+    so the warm worker can take them); the rest run here meanwhile."""
+    background = {name: Background(jobs[name]) for name in beside if name in jobs}
+    try:
+        done = {name: job() for name, job in jobs.items() if name not in background}
+        done.update({name: job.result() for name, job in background.items()})
+    finally:
+        for job in background.values():
+            job.close()
+    return {name: done[name] for name in jobs}
+
+
 #: The warm worker `Background` sends its work to while one is running (`warm_worker`).
 _WORKER: Worker | None = None
 
