@@ -123,6 +123,7 @@ def import_robot(
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
         else:  # home.py: out of self-contact, any joint between touching links may move
             _free_home(spec, report, doc, stage / f"{name}.yaml", path)
+        _narrow_limits(spec, report, doc, stage / f"{name}.yaml", path)
         writer.check(stage / f"{name}.yaml")
         for item in sorted(stage.rglob("*")):
             if item.is_file():
@@ -144,3 +145,26 @@ def _free_stance(spec: dict, report: Report, doc, spec_path: Path, path: Path) -
         "cannot rest on the floor"
     )
     _new_home(stance.free_home(spec_path), why, spec, report, doc, spec_path, path)
+
+
+def _narrow_limits(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
+    """Estimated position limits narrowed to the joint's range free of self-contact from home
+    (limits.py), one report line per joint; rewrite the spec."""
+    from simkit.importer import limits, writer
+
+    found = limits.narrowed(spec_path)
+    if not found:
+        return
+    for joint in spec["joints"]:
+        if joint["name"] in found:
+            old = (joint["lower"], joint["upper"])
+            joint["lower"], joint["upper"] = found[joint["name"]]
+            element = doc.root.find(f"joint[@name='{joint['name']}']")
+            report.assumed(
+                doc,
+                doc.root if element is None else element,
+                f"estimated limits {old[0]:.4g} .. {old[1]:.4g} narrowed to "
+                f"{joint['lower']:.4g} .. {joint['upper']:.4g}, the range the joint turns "
+                "from home without self-contact",
+            )
+    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")

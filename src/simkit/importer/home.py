@@ -105,7 +105,9 @@ def add_bodies(root: ET.Element, robot, base_dir: Path, shapes_of, geom) -> None
             geom(asset, body, shape, base_dir, f"{link.name}_{i}")
 
 
-def _model_xml(robot, base_dir: Path, also_excluded: tuple = ()) -> str:
+def _model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=_shapes) -> str:
+    """The search's collision-only MJCF: geoms from `shapes_of(link)` with half the clearance
+    as margin each, joined links and `also_excluded` pairs excluded, no parent filter."""
 
     root = ET.Element("mujoco")
     ET.SubElement(root, "compiler", angle="radian")
@@ -114,7 +116,7 @@ def _model_xml(robot, base_dir: Path, also_excluded: tuple = ()) -> str:
     ET.SubElement(
         ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
     )
-    add_bodies(root, robot, base_dir, _shapes, _geom)
+    add_bodies(root, robot, base_dir, shapes_of, _geom)
     contact = ET.SubElement(root, "contact")
     for a, b in sorted(_adjacent(robot) | set(also_excluded)):
         ET.SubElement(contact, "exclude", body1=a, body2=b)
@@ -198,12 +200,9 @@ def _within_limits(movable, q: np.ndarray) -> bool:
     )
 
 
-def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
-    """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
-    or None when the spec's home is already free or the search finds no free pose. Only the
-    joints between two links in contact move, each to the grid value that leaves the least
-    penetration, the one nearest the first guess on a tie."""
-    import mujoco
+def load(spec_path: Path):
+    """(robot, home or None when it has no movable joint, follow): the written spec resolved,
+    its home (spec order), and a function setting mimic joints of a pose from their leaders."""
     import yaml
 
     from simkit.model.resolve import resolve
@@ -211,10 +210,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
 
     text = spec_path.read_text(encoding="utf-8")
     robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
-    if "home" not in dict(robot.poses):  # no movable joint: nothing to move
-        return None
     movable = robot.movable_joints
-    start = np.array(dict(robot.poses)["home"], dtype=float)
     index = {j.name: i for i, j in enumerate(movable)}
 
     def follow(q: np.ndarray) -> np.ndarray:  # mimic joints follow their leaders
@@ -224,6 +220,23 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                 q[index[j.name]] = multiplier * q[index[leader]] + offset
         return q
 
+    poses = dict(robot.poses)
+    start = np.array(poses["home"], dtype=float) if "home" in poses else None
+    return robot, start, follow
+
+
+def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
+    """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
+    or None when the spec's home is already free or the search finds no free pose. Only the
+    joints between two links in contact move, each to the grid value that leaves the least
+    penetration, the one nearest the first guess on a tie."""
+    import mujoco
+
+    robot, start, follow = load(spec_path)
+    if start is None:  # no movable joint: nothing to move
+        return None
+    movable = robot.movable_joints
+    index = {j.name: i for i, j in enumerate(movable)}
     always = _always_touching(robot, spec_path.parent, start, follow)
     model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent, always))
     data = mujoco.MjData(model)

@@ -135,7 +135,10 @@ def free_range(
 ) -> tuple[float, float]:
     """Collision-free range (rad) of joint `index` about `home`, the others at home: from home
     toward each limit in `step`s, up to the last angle before a penetration deeper than `tol`
-    (the limit itself when none). Home itself is assumed free."""
+    (the limit itself when none). Home itself is assumed free. Each angle is tried as
+    robot.json publishes it (10 significant digits): at a grazing edge MuJoCo's depth jumps
+    (0.5 mm to 2.8 mm for 1e-10 rad on the imported quadruped), and the check tries the
+    published end."""
     import math
 
     q = list(home)
@@ -145,7 +148,7 @@ def free_range(
         count = max(1, math.ceil(abs(span) / step))
         last = home[index]
         for k in range(1, count + 1):
-            q[index] = limit if k == count else home[index] + span * k / count
+            q[index] = limit if k == count else rounded(home[index] + span * k / count)
             hit = worst(model, data, adr, q)
             if hit is not None and hit.depth > tol:
                 break

@@ -1,0 +1,111 @@
+"""Estimated position limits narrowed to the range a joint turns through without self-contact.
+
+A URDF joint without position limits gets +-pi rad (+-0.1 m) from the importer, marked
+estimated. A real joint without a stop still cannot turn a link through its neighbours: the
+double pendulum's second link folds onto the base at -180 deg. The kit's self-collision check
+(issue 12) holds estimated limits to be free of self-contact, as for the seed robots, so the
+estimate must be the free range, not a turn.
+
+Each such joint is swept from home towards each limit, the others at home (mimic followers
+follow), in `STEP` steps on the import's collision model (home.py: the links' collision
+shapes, plus their visual pieces, which the kit's collision pieces are grown to cover); the
+first sample where two links come closer than `home.CLEARANCE` ends the range, and the limit is
+set `BACK_OFF` steps short of it. Published (URDF) limits are never changed.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+STEP = {"revolute": math.radians(0.5), "prismatic": 0.001}  # rad, m
+BACK_OFF = 2  # steps kept clear of the first contact (the check sweeps in 2 deg steps)
+DIGITS = 4  # decimals of a narrowed limit, rounded towards home
+
+
+def _shapes(link) -> tuple:
+    """Collision shapes and, for a link that has some, its visual pieces too: the kit grows
+    its collision pieces to cover the visual (a link without collision has none in the kit)."""
+    from simkit.importer.home import _shapes as collision
+
+    given = tuple(collision(link))
+    return given + tuple(s for s in link.shapes if s not in given) if given else ()
+
+
+def narrowed(spec_path: Path) -> dict[str, tuple[float, float]]:
+    """{joint: (lower, upper)} for each joint whose estimated limits were narrowed (rad or
+    m), none when home itself is in contact (nothing to measure a free range from)."""
+    import mujoco
+
+    from simkit.importer import home
+
+    robot, start, follow = home.load(spec_path)
+    if start is None:
+        return {}
+    always = home._always_touching(robot, spec_path.parent, start, follow)
+    model = mujoco.MjModel.from_xml_string(
+        home._model_xml(robot, spec_path.parent, always, shapes_of=_shapes)
+    )
+    data = mujoco.MjData(model)
+    movable = robot.movable_joints
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    near = _closest(model, data, adr, start)
+    if any(d <= 0.0 for d in near.values()):
+        return {}
+    blocked = _blocked_against(model, data, adr, near)
+    out = {}
+    for i, joint in enumerate(movable):
+        if joint.mimic is not None or not {"lower", "upper"} & set(joint.estimated):
+            continue
+        ends = [
+            _free_end(blocked, start, i, follow, end, STEP[joint.type])
+            for end in (joint.lower, joint.upper)
+        ]
+        if (ends[0], ends[1]) != (joint.lower, joint.upper) and ends[1] - ends[0] > 1e-6:
+            out[joint.name] = (ends[0], ends[1])
+    return out
+
+
+def _closest(model, data, adr, q) -> dict[tuple[int, int], float]:
+    """The smallest distance (m) per body pair closer than the search clearance at `q`."""
+    from simkit.importer import home
+
+    home._penetration(model, data, adr, q)
+    out: dict[tuple[int, int], float] = {}
+    for contact in data.contact[: data.ncon]:
+        pair = tuple(sorted(int(model.geom_bodyid[g]) for g in contact.geom))
+        out[pair] = min(out.get(pair, math.inf), float(contact.dist))
+    return out
+
+
+def _blocked_against(model, data, adr, near: dict):
+    """A test of a pose: a pair comes closer than the clearance, or, for pairs already that
+    close at home (home.py keeps them apart, not a clearance apart), closer than half their
+    distance at home."""
+    from simkit.importer import home
+
+    def blocked(q: np.ndarray) -> bool:
+        for pair, dist in _closest(model, data, adr, q).items():
+            if dist < min(home.CLEARANCE, 0.5 * near.get(pair, math.inf)):
+                return True
+        return False
+
+    return blocked
+
+
+def _free_end(blocked, start, i: int, follow, end: float, step: float) -> float:
+    """`end` when the sweep from home reaches it free, else the last free value `BACK_OFF`
+    steps short of the first contact, rounded towards home; home when there is none."""
+    span = end - start[i]
+    count = math.ceil(abs(span) / step)
+    for k in range(1, count + 1):
+        q = start.copy()
+        q[i] = start[i] + span * k / count
+        if blocked(follow(q)):
+            free = start[i] + span * max(0, k - 1 - BACK_OFF) / count
+            scale = 10.0**DIGITS
+            rounded = (math.floor if span > 0 else math.ceil)(free * scale) / scale
+            return rounded if abs(rounded - start[i]) < abs(span) else start[i]
+    return end
