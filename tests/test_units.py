@@ -132,3 +132,30 @@ def test_canonical_faces_ignores_the_starting_corner_and_order():
     b = canonical_faces(Mesh.of(vertices, shuffled))
     assert digest(a) == digest(b)
     assert sorted(map(tuple, a.faces)) == sorted(map(tuple, faces))
+
+
+def test_given_hull_comes_from_the_cache_by_file_content(tmp_path):
+    """A given collision mesh's hull is computed once per file content and placement; the
+    cached hull is the computed one, and new bytes give a new hull."""
+    from simkit.derive.per_link import HULL_STEP, _given_hull, _shape_hull
+    from simkit.kitio.cache import Cache, digest
+    from simkit.kitio.stl import to_stl
+    from simkit.model.robot import Shape
+
+    cube = Mesh.of(
+        np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float),
+        np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]),
+    )  # fmt: skip
+    (tmp_path / "c.stl").write_bytes(to_stl(cube, "c"))
+    shape = Shape("mesh", (0.0, 0.0, 0.1), (0.0, 0.0, 0.0), file="c.stl", scale=0.5)
+    cache = Cache.at(tmp_path / "cache")
+    first = _given_hull(shape, tmp_path, cache)
+    assert len(list((tmp_path / "cache").rglob(f"*{HULL_STEP}*"))) >= 1
+    again = _given_hull(shape, tmp_path, cache)
+    assert digest(again) == digest(first) == digest(_shape_hull(shape, tmp_path))
+    assert np.asarray(first.vertices)[:, 2].max() == pytest.approx(0.6)
+    (tmp_path / "c.stl").write_bytes(to_stl(Mesh.of(cube.vertices * 2, cube.faces), "c"))
+    assert np.asarray(_given_hull(shape, tmp_path, cache).vertices)[:, 2].max() == (
+        pytest.approx(1.1)
+    )

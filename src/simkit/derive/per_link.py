@@ -26,6 +26,7 @@ Progress = Callable[[str], None]
 
 SOLID_STEP, SOLID_VERSION = "link_solid", 1
 COLLISION_STEP, COLLISION_VERSION = "collision", 3
+HULL_STEP, HULL_VERSION = "given_hull", 1
 
 
 def default_jobs() -> int:
@@ -79,12 +80,32 @@ def derive_solids(robot: Robot, base_dir: Path, cache: Cache) -> Robot:
             cache.put(SOLID_STEP, key, {"vertices": solid.vertices, "faces": solid.faces})
         links.append(replace(link, solid=solid))
     links = [
-        replace(link, given_hulls=tuple(_shape_hull(s, base_dir) for s in link.collision_shapes))
+        replace(
+            link, given_hulls=tuple(_given_hull(s, base_dir, cache) for s in link.collision_shapes)
+        )
         if link.collision_shapes
         else link
         for link in links
     ]
     return replace(robot, links=tuple(links))
+
+
+def _given_hull(shape: Shape, base_dir: Path, cache: Cache) -> Mesh:
+    """`_shape_hull` through the cache, keyed by the mesh file's bytes and the placement: G1's
+    24 hulls (46,734 triangles) took 2.8 s of a 4.9 s warm rebuild."""
+    from dataclasses import asdict
+
+    if shape.kind != "mesh":
+        return _shape_hull(shape, base_dir)
+    path = base_dir / (shape.file or "")
+    inputs = [path.read_bytes()] if path.is_file() else []
+    key = make_key(HULL_STEP, HULL_VERSION, inputs, {"shape": asdict(shape)}, ("manifold3d",))
+    found = cache.get(HULL_STEP, key) if inputs else None
+    if found is not None:
+        return Mesh.of(found["vertices"], found["faces"])
+    hull = _shape_hull(shape, base_dir)
+    cache.put(HULL_STEP, key, {"vertices": hull.vertices, "faces": hull.faces})
+    return hull
 
 
 def _shape_hull(shape: Shape, base_dir: Path) -> Mesh:
@@ -115,7 +136,7 @@ def canonical_faces(mesh: Mesh) -> Mesh:
     if not len(faces):
         return mesh
     start = np.argmin(faces, axis=1)
-    rolled = np.stack([np.roll(row, -s) for row, s in zip(faces, start, strict=True)])
+    rolled = np.take_along_axis(faces, (start[:, None] + np.arange(3)) % 3, axis=1)
     return Mesh.of(mesh.vertices, rolled[np.lexsort(rolled.T[::-1])])
 
 
