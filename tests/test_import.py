@@ -85,7 +85,8 @@ def test_gaps_are_estimated_and_reported(tmp_path):
     assert slider.inertia_decision is not None and slider.inertia_decision.action == "balance"
     assert "triangle inequality" in slider.inertia_decision.reason
     text = "\n".join(done.lines)
-    assert "transmission[turn_trans]: not imported" in text
+    assert "transmission[turn_trans]" not in text  # kept (urdf_blocks), so not reported
+    assert "gazebo: not imported: names 'no_such_link'" in text
     assert "arm.urdf:53: limit: estimated: no effort limit" in text
     assert all(f"#   {line}" in done.spec_path.read_text() for line in done.lines)
 
@@ -177,11 +178,52 @@ def test_corpus_floating_base_and_dae(tmp_path):
     assert (tmp_path / "ur5" / "meshes" / "base.stl").is_file()
 
 
+def test_gazebo_transmission_and_ros2_control_blocks_are_kept_verbatim(tmp_path):
+    """Each block is the URDF's own text, in file order; one naming a missing link is left
+    out with a report line (test_gaps_are_estimated_and_reported)."""
+    done = import_robot(ARM, tmp_path)
+    spec, _doc = load_spec(done.spec_path)
+    source = ARM.read_text()
+    assert [b.split(">", 1)[0].split()[0] for b in spec.urdf_blocks] == [
+        "<transmission",
+        "<gazebo",
+        "<gazebo",
+        "<ros2_control",
+    ]
+    for block in spec.urdf_blocks[:2]:
+        assert block in source  # verbatim (no namespace declarations were in scope)
+    assert '<ctrl:plugin name="arm_controller"' in spec.urdf_blocks[2]
+
+
+def test_a_block_naming_a_missing_joint_is_a_one_line_spec_error(tmp_path):
+    done = import_robot(ARM, tmp_path)
+    text = done.spec_path.read_text().replace('<joint name="slide">', '<joint name="slid">')
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text)
+    with pytest.raises(SpecError, match="names joint 'slid', which the spec lacks") as info:
+        load_spec(bad)
+    assert "urdf_blocks[3]" in str(info.value) and "\n" not in str(info.value)
+
+
 @pytest.mark.slow
 def test_imported_arm_builds(tmp_path, kit_factory):
+    """The kit's URDF carries the blocks as the URDF had them, and the check sees a change."""
+    from simkit.check.kit import Kit
+    from simkit.check.urdf import check_urdf
+
     done = import_robot(ARM, tmp_path)
     result = kit_factory(str(done.spec_path))
-    assert result.kit_dir.is_dir()
+    urdf = next(result.kit_dir.glob("urdf/*.urdf"))
+    text = urdf.read_text()
+    spec, _doc = load_spec(done.spec_path)
+    assert all(block in text for block in spec.urdf_blocks)
+    kit = tmp_path / "kit"
+    shutil.copytree(result.kit_dir, kit)
+    found = {f.check: f.ok for f in check_urdf(Kit.open(kit))}
+    assert found["urdf.blocks"] and found["urdf.blocks.names"]
+    tampered = kit / urdf.relative_to(result.kit_dir)
+    tampered.write_text(text.replace("<mu1>0.9</mu1>", "<mu1>0.5</mu1>"))
+    assert not {f.check: f.ok for f in check_urdf(Kit.open(kit))}["urdf.blocks"]
 
 
 def test_large_cad_meshes_leave_the_step_out(tmp_path, monkeypatch):

@@ -40,6 +40,7 @@ def check_urdf(kit: Kit) -> list[Finding]:
         )
     )
     findings.extend(_joint_findings(kit, urdf))
+    findings.extend(_carried_blocks(kit, path, urdf))
     tool = kit.doc.get("tool_frame")
     if tool:
         names = [j["name"] for j in kit.joints]
@@ -106,5 +107,46 @@ def _joint_findings(kit: Kit, urdf) -> list[Finding]:
             ],
             TOL,
             "SI",
+        ),
+    ]
+
+
+def _carried_blocks(kit: Kit, path, urdf) -> list[Finding]:
+    """robot.json `urdf_blocks` (an import's gazebo, transmission and ros2_control blocks)
+    are the URDF's last top-level elements, in order, with the same canonical XML, and every
+    link or joint they name is one yourdfpy read from the URDF."""
+    import xml.etree.ElementTree as ET
+
+    from simkit.spec import urdf_blocks
+
+    recorded = kit.doc.get("urdf_blocks") or []
+    if not recorded:
+        return []
+    written = list(ET.parse(path).getroot())[-len(recorded) :]
+    texts = [ET.tostring(e, encoding="unicode") for e in written]
+    same = (
+        [
+            w.tag == r["tag"] and urdf_blocks.digest(t) == r["sha256"]
+            for w, t, r in zip(written, texts, recorded, strict=True)
+        ]
+        if len(written) == len(recorded)
+        else []
+    )
+    known = {link.name for link in urdf.robot.links} | {j.name for j in urdf.robot.joints}
+    named = [n for r in recorded for n in r["names"]]
+    unknown = sorted(set(named) - known)
+    return [
+        require(
+            "urdf.blocks",
+            len(written) == len(recorded) and all(same),
+            f"{sum(same)} of {len(recorded)} carried blocks (gazebo, transmission, "
+            "ros2_control) are in the URDF, in order, as robot.json records them",
+        ),
+        require(
+            "urdf.blocks.names",
+            not unknown,
+            f"links or joints the carried blocks name but the URDF lacks: {unknown[:3]}"
+            if unknown
+            else f"the {len(set(named))} links and joints the carried blocks name are in the URDF",
         ),
     ]

@@ -12,6 +12,7 @@ from simkit.kitio import layout
 from simkit.kitio.cache import library_versions
 from simkit.kitio.jsonout import dumps
 from simkit.model.robot import InertiaDecision, Joint, Link, Robot, SimReports
+from simkit.spec import urdf_blocks
 
 LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core", "cadquery-ocp")
 
@@ -204,6 +205,7 @@ def _products(robot: Robot, reports: SimReports) -> dict:
     p = robot.products
     out = {
         "ros2_control": p.ros2_control,
+        "urdf_blocks": [urdf_blocks.summary(b) for b in robot.urdf_blocks] or None,
         "collision_pairs": p.collision_pairs,
         "ik_reference": p.ik_reference,
         "motion": p.motion,

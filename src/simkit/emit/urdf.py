@@ -138,4 +138,21 @@ def emit(robot: Robot) -> dict[str, bytes]:
         _origin(joint, frame.xyz, frame.rpy)
         _massless(sub(root, "link", name=frame.name))
     root.extend(ros2_control.urdf_elements(robot))  # spec `ros2_control:` only; else nothing
-    return {file: to_bytes(root, HEADER.format(spec=robot.spec_file))}
+    for i in range(len(robot.urdf_blocks)):  # placeholders for the carried blocks
+        sub(root, BLOCK_TAG, index=str(i))
+    text = to_bytes(root, HEADER.format(spec=robot.spec_file)).decode("utf-8")
+    return {file: _with_blocks(text, robot.urdf_blocks).encode("utf-8")}
+
+
+BLOCK_TAG = "simkit_urdf_block"
+
+
+def _with_blocks(text: str, blocks: tuple[str, ...]) -> str:
+    """`text` with each placeholder replaced, in one pass, by its block's XML exactly as the
+    spec holds it (the source URDF's namespace prefixes and layout kept)."""
+    import re
+
+    if not blocks:
+        return text
+    pattern = re.compile(rf'<{BLOCK_TAG} index="(\d+)" />')
+    return pattern.sub(lambda m: blocks[int(m.group(1))], text)

@@ -99,7 +99,7 @@ def import_robot(
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `hull_collision`: links whose URDF collision has meshes collide with their visual
     solid's convex hull instead (one piece; reported per link)."""
-    from simkit.importer import convert, meshes, names, source, writer
+    from simkit.importer import blocks, convert, meshes, names, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
@@ -111,7 +111,8 @@ def import_robot(
         stage = Path(tmp)
         mesh_writer = meshes.MeshWriter(stage)
         spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
-        names.make_legal(spec, doc, report)
+        renames = names.make_legal(spec, doc, report)
+        blocks.keep(spec, doc, report, blocks.collect(doc), renames)
         if strict and report.problems:
             first = report.problems[0]
             first.more = len(report.problems) - 1

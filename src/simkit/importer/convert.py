@@ -12,8 +12,9 @@ from simkit.importer.links import has_geometry, has_mass, link_spec
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
 from simkit.importer.source import Source
+from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 
-TOP = {"link", "joint", "material"}
+TOP = ("link", "joint", "material")
 
 
 def _tree(source: Source) -> tuple[dict, dict, str]:
@@ -112,7 +113,7 @@ def convert(
 ) -> dict:
     """The spec dict for the whole robot."""
     for element in source.root:
-        if isinstance(element.tag, str) and element.tag not in TOP:
+        if isinstance(element.tag, str) and element.tag not in TOP + URDF_BLOCK_TAGS:
             report.dropped(
                 source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
             )

@@ -53,14 +53,16 @@ def _construct(spec: dict) -> dict:
     return out
 
 
-def make_legal(spec: dict, source: Source, report: Report) -> None:
+def make_legal(spec: dict, source: Source, report: Report) -> dict[str, dict[str, str]]:
     """Rename (in place, with every reference) the links, joints and frames whose names the
-    spec refuses; one `changed` line each at the URDF element."""
+    spec refuses; one `changed` line each at the URDF element. Returns {"links" | "joints" |
+    "frames": {URDF name: spec name}} for what was renamed."""
     original: dict[str, str] = {}  # a renamed name -> the URDF's
+    final: dict[str, dict[str, str]] = {}
     for _ in range(ROUNDS):
         bad = _problems(spec)
         if not bad:
-            return
+            return final
         taken = {n.lower() for key in _REFS for n in (i["name"] for i in spec.get(key, []))}
         renames: dict[str, dict[str, str]] = {}
         for (key, index), why in sorted(bad.items()):
@@ -75,10 +77,12 @@ def make_legal(spec: dict, source: Source, report: Report) -> None:
             taken.add(new.lower())
             renames.setdefault(key, {})[old] = new
             original[new] = urdf = original.get(old, old)
+            final.setdefault(key, {})[urdf] = new
             tag = "joint" if key == "joints" else "link"
             element = next((e for e in source.root.iter(tag) if e.get("name") == urdf), None)
             report.changed(source, element, f"renamed to '{new}' ({why})")
         _apply(spec, renames)
+    return final
 
 
 def _apply(spec: dict, renames: dict[str, dict[str, str]]) -> None:

@@ -21,6 +21,14 @@ def _dict(dumper: yaml.SafeDumper, data: dict) -> yaml.Node:
     return dumper.represent_mapping("tag:yaml.org,2002:map", data.items(), flow_style=flow)
 
 
+def _str(dumper: yaml.SafeDumper, data: str) -> yaml.Node:
+    """Literal block style for multi-line text (an XML block of `urdf_blocks`), so the spec
+    shows it as the URDF had it; PyYAML falls back to quoting where a block cannot hold it."""
+    style = "|" if "\n" in data else None
+    return dumper.represent_scalar("tag:yaml.org,2002:str", data, style=style)
+
+
+_Dumper.add_representer(str, _str)
 _Dumper.add_representer(list, _list)
 _Dumper.add_representer(tuple, _list)
 _Dumper.add_representer(dict, _dict)

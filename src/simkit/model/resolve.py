@@ -216,5 +216,6 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         step=spec.step,
         mjcf=spec.mjcf,
         ros2_control=spec.ros2_control,
+        urdf_blocks=spec.urdf_blocks,
         freefall=spec.freefall,
     )

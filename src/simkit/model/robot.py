@@ -272,6 +272,9 @@ class Robot:
     #: Gazebo / ros2_control additions and the free-fall validation (frozen spec sections)
     ros2_control: Ros2ControlSpec | None = None
     freefall: FreefallSpec | None = None
+    #: URDF elements carried over verbatim (spec `urdf_blocks`: an import's gazebo,
+    #: transmission and ros2_control blocks), as XML text
+    urdf_blocks: tuple[str, ...] = ()
 
     def link(self, name: str) -> Link:
         for link in self.links:

@@ -19,6 +19,7 @@ TURNS = 2  # joint limits and poses of revolute joints: at most this many turns 
 MAX_TITLE = 200
 MAX_TEXT = 5000  # description, notes
 MAX_STRING = 500  # any other string (sources, plugin names, estimated fields, ...)
+MAX_BLOCK = 20000  # one carried URDF block (`urdf_blocks`: a Gazebo plugin's XML)
 MAX_ANY = 1e6  # any other number
 MAX_BODIES = 256  # links, joints, frames: every step is at least linear in them
 MAX_ITEMS = 1000  # any other list
@@ -91,9 +92,10 @@ def _number(loc: Loc, value: float) -> str | None:
 def _string(loc: Loc, value: str) -> str | None:
     field = next((str(p) for p in reversed(loc) if isinstance(p, str)), "")
     cap = MAX_TITLE if field == "title" else MAX_TEXT if field in _MULTILINE else MAX_STRING
+    cap = MAX_BLOCK if field == "urdf_blocks" else cap
     if len(value) > cap:
         return f"at most {cap} characters (this has {len(value)})"
-    allowed = "\n" if field in _MULTILINE else ""
+    allowed = "\n\t" if field == "urdf_blocks" else "\n" if field in _MULTILINE else ""
     if any(not (c.isprintable() or c in allowed) for c in value):
         return "control characters are not allowed" + (
             "" if allowed else " (one line of printable text)"

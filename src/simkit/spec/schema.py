@@ -334,3 +334,6 @@ class RobotSpec(Strict):
     #: Gazebo / ros2_control additions and the free-fall validation (spec_sim.py)
     ros2_control: Ros2ControlSpec | None = None
     freefall: FreefallSpec | None = None
+    #: URDF `<gazebo>`, `<transmission>` and `<ros2_control>` elements, each as its XML text,
+    #: written into the kit's URDF verbatim after the joints (spec/urdf_blocks.py)
+    urdf_blocks: tuple[str, ...] = ()

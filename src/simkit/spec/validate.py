@@ -18,6 +18,7 @@ from simkit.spec import bounds as spec_bounds
 from simkit.spec import mjcf as spec_mjcf
 from simkit.spec import names as spec_names
 from simkit.spec import sim as spec_sim
+from simkit.spec import urdf_blocks as spec_urdf_blocks
 from simkit.spec.load import Loc, SourceDoc, dotted, load_yaml
 from simkit.spec.schema import InertiaSpec, RobotSpec, depth_first
 
@@ -147,6 +148,12 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
     yield from _floating(spec)
     yield from spec_mjcf.problems(spec, set(links), {f.name for f in spec.frames})
     yield from spec_sim.problems(spec, inertia_problem)
+    frames = {f.name for f in spec.frames}
+    yield from spec_urdf_blocks.problems(
+        spec,
+        {spec.root, *links, *frames},
+        {j.name for j in spec.joints} | {f"{name}_joint" for name in frames},
+    )
 
     movable = [j for j in spec.joints if j.type not in ("fixed", "floating")]
     for key in ("poses", "poses_deg"):
