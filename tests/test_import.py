@@ -253,3 +253,23 @@ def test_spec_step_false_builds_without_step(tmp_path):
     result = build(str(spec), tmp_path / "out")
     assert not any(path.startswith("step/") for path in result.files)
     assert json.loads(result.files["robot.json"])["geometry"]["step"] is None
+
+
+def test_a_second_visual_colour_is_reported_not_dropped_silently(tmp_path):
+    """A kit link is one solid with one material: the first visual's colour wins, and each
+    other colour gets a report line."""
+    inertia = '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>'
+    urdf = tmp_path / "two_colours.urdf"
+    urdf.write_text(
+        '<robot name="two_colours"><link name="base"><inertial><mass value="1"/>'
+        f"{inertia}</inertial>"
+        '<visual><geometry><box size="0.1 0.1 0.1"/></geometry>'
+        '<material name="red"><color rgba="1 0 0 1"/></material></visual>'
+        '<visual><origin xyz="0 0 0.1"/><geometry><box size="0.1 0.1 0.1"/></geometry>'
+        '<material name="blue"><color rgba="0 0 1 1"/></material></visual></link></robot>'
+    )
+    done = import_robot(urdf, tmp_path / "out")
+    spec, _doc = load_spec(done.spec_path)
+    assert {m.name: m.rgba for m in spec.materials}[spec.links[0].material] == (1, 0, 0, 1)
+    line = next(line for line in done.lines if "colour 0 0 1 1" in line)
+    assert line.startswith("two_colours.urdf:1: visual: changed:") and "1 0 0 1" in line

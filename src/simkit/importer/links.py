@@ -145,6 +145,13 @@ def link_spec(
         if info is not None and info.repair == "hull":
             report.changed(source, visual, f"{shape['file']}: open mesh, its convex hull is used")
         colour = _colour(source, visual, materials) or (info.rgba if info else None)
+        if colour is not None and rgba is not None and tuple(map(float, colour)) != rgba:
+            report.changed(  # a kit link is one solid with one material
+                source,
+                visual,
+                f"colour {' '.join(f'{c:g}' for c in colour)}: the link's solid takes its "
+                f"first visual's colour, {' '.join(f'{c:g}' for c in rgba)}",
+            )
         if rgba is None and colour is not None:
             rgba = tuple(float(c) for c in colour)
     collisions, infos = [], []
