@@ -109,6 +109,16 @@ def _mj_local(mj, body: int) -> np.ndarray:
     return out
 
 
+def _to_welded(mj, child: int, parent: str, joint: UsdJoint) -> bool:
+    """A fixed USD joint from a body welded to the world to an MJCF child of the world: both
+    formats hold the child fixed to the world (emit/usd.py fixes a massless root frame's other
+    links to its first one, so that one articulation holds them)."""
+    if joint.kind != "fixed" or int(mj.body_parentid[child]) != 0 or parent == "world":
+        return False
+    body = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_BODY, parent)
+    return body > 0 and int(mj.body_weldid[body]) == 0
+
+
 def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str]) -> list[Finding]:
     """Every USD joint joins the MJCF parent and child bodies at the MJCF body frame; movable
     joints have the MJCF axis, limits and servo. `names`: USD path -> link name."""
@@ -118,6 +128,8 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
     for j in joints:
         child = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_BODY, names.get(j.body1, "?"))
         parent = names.get(j.body0, "world")
+        if child >= 0 and _to_welded(mj, child, parent, j):
+            continue  # fixed to the world in both; the FK checks its frame
         if child < 0 or mj.body(int(mj.body_parentid[child])).name != parent:
             wrong.append(j.path)
         elif parent != "world":  # a joint from the world: the FK checks its frame

@@ -26,6 +26,13 @@ from simkit.model.kinematics import jointed_pairs, quat_wxyz, rpy_matrix
 from simkit.model.robot import Link, Robot, Shape
 
 SAMPLES = 10_000
+#: configurations (the first of the sampled ones) a pair's contact is counted in for "Always"
+ALWAYS_SAMPLES = 1000
+#: share of those a pair must be in contact in to be "Always" (MoveIt Setup Assistant's
+#: "min. collisions for always-colliding pairs", 95 % by default)
+ALWAYS_FRACTION = 0.95
+#: m: geometry closer than this touches (faces that meet exactly, up to rounding)
+TOUCH = 1e-6
 SAMPLED_TYPES = ("revolute", "continuous", "prismatic")
 METHOD = (
     "MoveIt Setup Assistant's rule: 'Adjacent' = links joined by a joint (links without "
@@ -108,15 +115,19 @@ def _mesh_geom(asset: ET.Element, body: ET.Element, name: str, vertices: np.ndar
     ET.SubElement(body, "geom", type="mesh", mesh=name)
 
 
-def collision_model_xml(robot: Robot, skip: list[tuple[str, str]] = ()) -> str:
+def collision_model_xml(robot: Robot, skip: list[tuple[str, str]] = (), margin: float = 0.0) -> str:
     """MJCF of the links' collision geometry, every link pair able to touch except `skip`:
     every body has a degree of freedom (fixed joints get a locked slide) so MuJoCo welds none
-    together, and the parent filter is off."""
+    together, and the parent filter is off. `margin` (m, per geom): contacts closer than
+    twice it count."""
     root = ET.Element("mujoco", model=f"{robot.name}_collision_pairs")
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false")
     option = ET.SubElement(root, "option")
     ET.SubElement(option, "flag", filterparent="disable", gravity="disable")
-    ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin="0")
+    margin_text = repr(float(margin)) if margin else "0"
+    ET.SubElement(
+        ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin_text
+    )
     asset = ET.SubElement(root, "asset")
     bodies = {robot.root: ET.SubElement(root, "worldbody")}
     for joint in robot.joints:
@@ -221,29 +232,38 @@ def _kit_collides(link: Link) -> bool:
 
 
 def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
-    """Link pairs the kit's MJCF would let collide whose collision geometry is in contact in
-    every configuration of `q` (MoveIt Setup Assistant's "Always"): a URDF's collision shapes
-    that overlap wherever the joints are (Talos's hip-yaw and thigh hulls) can never be
-    separated, so their contact is an artefact of the geometry, and the kit excludes it."""
+    """Link pairs the kit's MJCF would let collide whose collision geometry is in contact (or
+    within `TOUCH`, numerically touching) in at least `ALWAYS_FRACTION` of the configurations
+    of `q` (MoveIt Setup Assistant's "Always", its min_collision_fraction): a URDF's
+    collision shapes that overlap wherever the joints are (Talos's hip-yaw and thigh hulls,
+    TIAGo's fingertip inside the hand's safety box but in one pose of a thousand, Baxter's
+    finger blocks sliding face on face) can never, or almost never, be separated, so their
+    contact is an artefact of the geometry, and the kit excludes it."""
     import mujoco
 
     if not len(q):
         return []
     q = _follow_mimics(robot, q)
+    need = math.ceil(ALWAYS_FRACTION * len(q) - 1e-9)
     skip = welded_pairs(robot) | {tuple(sorted(p)) for p in jointed_pairs(robot)}
-    first = first_contacts(robot, q[:1], sorted(skip))
     kit = {link.name for link in robot.links if _kit_collides(link)}
-    candidates = {p for p, index in first.items() if index == 0 and set(p) <= kit}
     solid = sorted(link.name for link in robot.links if has_geometry(link))
     names = [j for j, _, _ in sampled_joints(robot)]
-    others = [p for p in itertools.combinations(solid, 2) if p not in candidates]
-    model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, others))
-    data = mujoco.MjData(model)
-    adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
-    body_name = [model.body(i).name for i in range(model.nbody)]
-    for row in q[1:]:
+    candidates = {p for p in itertools.combinations(solid, 2) if p not in skip and set(p) <= kit}
+    count = dict.fromkeys(candidates, 0)
+    body_name, model, data, adr = [], None, None, None
+    for index, row in enumerate(q):
+        # a pair that cannot reach `need` any more is dropped (the model is rebuilt without
+        # the dropped pairs after doubling batches of rows)
+        candidates = {p for p in candidates if count[p] + len(q) - index >= need}
         if not candidates:
             break
+        if model is None or (index & (index - 1) == 0 and index >= 32):
+            others = [p for p in itertools.combinations(solid, 2) if p not in candidates]
+            model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, others, TOUCH / 2))
+            data = mujoco.MjData(model)
+            adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
+            body_name = [model.body(i).name for i in range(model.nbody)]
         data.qpos[adr] = row
         mujoco.mj_kinematics(model, data)
         mujoco.mj_collision(model, data)
@@ -251,8 +271,9 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
         for g1, g2 in data.contact.geom[: data.ncon]:
             a, b = body_name[model.geom_bodyid[g1]], body_name[model.geom_bodyid[g2]]
             touching.add((a, b) if a < b else (b, a))
-        candidates &= touching
-    return sorted(candidates)
+        for p in touching & candidates:
+            count[p] += 1
+    return sorted(p for p in candidates if count[p] >= need)
 
 
 def _follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -266,10 +287,6 @@ def _follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
             leader, multiplier, offset = joint.mimic
             q[:, index[joint.name]] = multiplier * q[:, index[leader]] + offset
     return q
-
-
-#: configurations (the first of the sampled ones) a pair must be in contact in to be "Always"
-ALWAYS_SAMPLES = 1000
 
 
 def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
@@ -292,5 +309,10 @@ def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
     }
     if always:
         block["always"] = [list(p) for p in always]
+        block["always_rule"] = {
+            "samples": ALWAYS_SAMPLES,
+            "fraction": ALWAYS_FRACTION,
+            "touch": TOUCH,
+        }
     seeds = {**robot.products.seeds, "collision_pairs": seed}
     return replace(robot, products=replace(robot.products, collision_pairs=block, seeds=seeds))

@@ -11,7 +11,10 @@ Layout of `usd/NAME.usda` (Z up, metres, kilograms):
   turned so the joint axis is the schema's X/Y/Z token; limits and drive gains follow the
   UsdPhysics units (degrees for angular joints). A joint from the root frame targets `/NAME`
   itself, so the robot stays fixed to wherever the asset is placed; a floating base has no
-  such joint.
+  such joint. Where a massless root frame holds several links by fixed joints (TIAGo's
+  base_footprint: base_link, base_cover_link), only the first is fixed to `/NAME`; the others
+  are fixed to that first link at the same place, since UsdPhysics parsers start one
+  articulation per body fixed to the world (all of them are welded to the world either way).
 - `/NAME/Looks/MATERIAL`: one UsdPreviewSurface material per spec colour.
 
 The stage is built in memory and serialised with `Sdf.Layer.ExportToString`, so the text
@@ -255,7 +258,13 @@ def _link(stage, root: str, robot: Robot, link: Link, pose: np.ndarray, material
             )
 
 
-def _joint(stage, root: str, robot: Robot, joint) -> None:
+def _anchor(robot: Robot):
+    """The first fixed joint from the root frame: its child is the one link fixed to `/NAME`
+    (None when no fixed joint leaves the root frame)."""
+    return next((j for j in robot.joints if j.parent == robot.root and j.type == "fixed"), None)
+
+
+def _joint(stage, root: str, robot: Robot, joint, anchor=None) -> None:
     from pxr import Gf, UsdPhysics
 
     path = f"{root}/joints/{prim_name(joint.name)}"
@@ -266,11 +275,17 @@ def _joint(stage, root: str, robot: Robot, joint) -> None:
     else:
         schema = UsdPhysics.FixedJoint.Define(stage, path)
     body0 = root if joint.parent == robot.root else f"{root}/{prim_name(joint.parent)}"
+    token, turn = axis_frame(joint.axis) if joint.movable else ("X", np.eye(3))
+    xyz, rot = np.asarray(joint.xyz, dtype=float), rpy_matrix(joint.rpy)
+    if anchor is not None and joint.type == "fixed" and joint.parent == robot.root:
+        # the joint frame in the anchor link's frame: inv(T_root_anchor) @ T_root_joint
+        body0 = f"{root}/{prim_name(anchor.child)}"
+        rot_a = rpy_matrix(anchor.rpy)
+        xyz, rot = rot_a.T @ (xyz - np.asarray(anchor.xyz, dtype=float)), rot_a.T @ rot
     schema.CreateBody0Rel().SetTargets([body0])
     schema.CreateBody1Rel().SetTargets([f"{root}/{prim_name(joint.child)}"])
-    token, turn = axis_frame(joint.axis) if joint.movable else ("X", np.eye(3))
-    schema.CreateLocalPos0Attr(Gf.Vec3f(*_r(joint.xyz)))
-    schema.CreateLocalRot0Attr(_quatf(rpy_matrix(joint.rpy) @ turn))
+    schema.CreateLocalPos0Attr(Gf.Vec3f(*_r(xyz)))
+    schema.CreateLocalRot0Attr(_quatf(rot @ turn))
     schema.CreateLocalPos1Attr(Gf.Vec3f(0.0, 0.0, 0.0))
     schema.CreateLocalRot1Attr(_quatf(turn))
     if not joint.movable:
@@ -343,10 +358,11 @@ def stage_text(robot: Robot) -> str:
         api = UsdPhysics.FilteredPairsAPI.Apply(stage.GetPrimAtPath(f"{root}/{prim_name(child)}"))
         api.CreateFilteredPairsRel().SetTargets(paths)
     stage.DefinePrim(f"{root}/joints", "Scope")
+    anchor = _anchor(robot)
     for joint in robot.joints:
         if joint.type == "floating":
             continue  # a free base body: UsdPhysics has no joint to the world for it
-        _joint(stage, root, robot, joint)
+        _joint(stage, root, robot, joint, None if joint is anchor else anchor)
     return layer.ExportToString()
 
 

@@ -162,33 +162,52 @@ def _between(robot, a: str, b: str) -> list:
     return [j for j in ua + ub if j.name not in common and j.movable and j.mimic is None]
 
 
-#: random configurations (seeded) a pair must touch in, with the first guess, to count as
-#: always in contact
+#: random configurations (seeded) a pair's contact is counted in to tell an always pair
 ALWAYS_SAMPLES = 200
+#: the share of them it must touch in, and m: closer than this touches (the kit's rule,
+#: derive/collision_pairs.py ALWAYS_FRACTION and TOUCH: MoveIt Setup Assistant's "Always")
+ALWAYS_FRACTION = 0.95
+TOUCH = 1e-6
+
+
+def _contacts(model, data, adr, q) -> set[tuple[str, str]]:
+    """Link pairs (sorted names) touching or closer than `TOUCH` at `q`."""
+    _penetration(model, data, adr, q)
+    out = set()
+    for i in range(data.ncon):
+        if data.contact.dist[i] < TOUCH:
+            g1, g2 = data.contact.geom[i]
+            a = model.body(model.geom_bodyid[g1]).name
+            b = model.body(model.geom_bodyid[g2]).name
+            out.add((a, b) if a < b else (b, a))
+    return out
 
 
 def _always_touching(robot, base_dir: Path, start: np.ndarray, follow) -> tuple:
-    """Link pairs touching at the first guess and in every one of `ALWAYS_SAMPLES` seeded
-    random configurations: URDF collision shapes that overlap wherever the joints are (Panda
-    collision primitives of links 1 and 3). The kit excludes such pairs (derive
-    collision_pairs "always", as MoveIt Setup Assistant does), so no pose can or need
-    separate them; the search must not try, or it never moves the pair it could fix."""
+    """Link pairs touching at the first guess and in at least `ALWAYS_FRACTION` of
+    `ALWAYS_SAMPLES` seeded random configurations: URDF collision shapes that overlap wherever
+    (or almost wherever) the joints are (Panda collision primitives of links 1 and 3, TIAGo's
+    fingertips in the hand's safety box, Baxter's finger blocks face on face). The kit
+    excludes such pairs (derive collision_pairs "always", as MoveIt Setup Assistant does), so
+    no pose can or need separate them; the search must not try, or it never moves the pair it
+    could fix."""
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir))
     data = mujoco.MjData(model)
     movable = robot.movable_joints
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
-    _depth, pairs = _penetration(model, data, adr, start)
+    pairs = _contacts(model, data, adr, start)
     rng = np.random.default_rng(robot.seed)
     low = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
     high = np.array([j.upper if j.upper is not None else math.pi for j in movable])
+    allowed = ALWAYS_SAMPLES - math.ceil(ALWAYS_FRACTION * ALWAYS_SAMPLES - 1e-9)
+    misses = dict.fromkeys(pairs, 0)
     for _ in range(ALWAYS_SAMPLES if pairs else 0):
-        _depth, found = _penetration(model, data, adr, follow(rng.uniform(low, high)))
-        pairs &= found
-        if not pairs:
-            break
-    return tuple(sorted(tuple(sorted(p)) for p in pairs))
+        found = _contacts(model, data, adr, follow(rng.uniform(low, high)))
+        for p in misses:
+            misses[p] += p not in found
+    return tuple(sorted(p for p, n in misses.items() if n <= allowed))
 
 
 def _within_limits(movable, q: np.ndarray) -> bool:
