@@ -273,3 +273,25 @@ def test_a_second_visual_colour_is_reported_not_dropped_silently(tmp_path):
     assert {m.name: m.rgba for m in spec.materials}[spec.links[0].material] == (1, 0, 0, 1)
     line = next(line for line in done.lines if "colour 0 0 1 1" in line)
     assert line.startswith("two_colours.urdf:1: visual: changed:") and "1 0 0 1" in line
+
+
+@pytest.mark.parametrize(
+    ("block", "message"),
+    [
+        ("<gazebo><a></gazebo>", "not well-formed XML"),
+        ("<link name='x'/>", "is not one of <gazebo>, <transmission>, <ros2_control>"),
+        ('<?xml version="1.0"?><gazebo/>', "must start with <gazebo>"),
+        ("<gazebo reference='nowhere'/>", "names link or joint 'nowhere'"),
+    ],
+)
+def test_bad_urdf_blocks_are_refused_on_one_line(tmp_path, block, message):
+    """A block goes verbatim inside the kit URDF's <robot>: it must be one element of the
+    three tags, naming only what the spec has."""
+    done = import_robot(ARM, tmp_path)
+    spec = yaml.safe_load(done.spec_path.read_text())
+    spec["urdf_blocks"] = [block]
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(spec, sort_keys=False))
+    with pytest.raises(SpecError, match=message) as info:
+        load_spec(bad)
+    assert "urdf_blocks[0]" in str(info.value) and "\n" not in str(info.value)

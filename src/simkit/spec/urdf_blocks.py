@@ -44,6 +44,9 @@ def problems(spec, links: set[str], joints: set[str]) -> Iterator[Problem]:
         if element.tag not in TAGS:
             yield where, f"<{element.tag}> is not one of <{'>, <'.join(TAGS)}>"
             continue
+        if not text.startswith(f"<{element.tag}"):  # an XML declaration, DOCTYPE or comment
+            yield where, f"must start with <{element.tag}> (it goes inside the URDF's <robot>)"
+            continue
         if element.tag == "ros2_control" and spec.ros2_control is not None:
             yield where, "a <ros2_control> block and a `ros2_control:` section both write one"
         for kind, name in references(element):
