@@ -5,8 +5,8 @@ Humanoids often hang their arms through their thighs at 0 (Talos's grippers sit 
 its thigh hulls), so the kit's servos would hold a pose its own links penetrate and the
 robot pushes itself over. This module measures self-contact with MuJoCo on the links'
 collision geometry as the spec gives it (primitives, the convex hull of each given collision
-mesh, else of each visual piece) with the kit's exclusions (links joined by a joint or welded
-by fixed joints), ignores pairs in contact in every sampled configuration (the kit excludes
+mesh, else of each visual piece) with the kit's exclusions (links joined by a joint, or through
+links without geometry), ignores pairs in contact in every sampled configuration (the kit excludes
 those, derive/collision_pairs.always_pairs), and moves one joint at a time to the value on a
 grid of its range that leaves the least penetration. Joints that carry a foot (a link whose
 lowest point at home is on the floor) stay put: the stance is the standing check's business.
@@ -28,6 +28,8 @@ SAMPLES = 200  # random configurations that tell an always-touching pair
 FOOT = 0.01  # m: a link whose lowest point is this close to the robot's lowest is a foot
 SUPPORT = 0.003  # m: solid points this close to the lowest one touch the floor
 MARGIN = 0.01  # m: how far inside its support the CoM of a robot at rest must lie
+#: m: penetration the kit's self-collision check allows (simulate/self_collision.TOLERANCE)
+TOUCH = 0.0005
 STABLE_SAMPLES = 2000  # random poses tried for one the robot rests on
 
 
@@ -38,17 +40,15 @@ def _shapes(link) -> tuple:
 def _model_xml(robot, base_dir: Path) -> str:
     """Collision geometry only; every body but a fixed joint's child moves (fixed children
     are welded, as MuJoCo does in the kit), the parent filter on."""
-    from simkit.importer.home import add_bodies
+    from simkit.importer.home import _adjacent, add_bodies
 
     root = ET.Element("mujoco")
     ET.SubElement(root, "compiler", angle="radian")
     ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
     add_bodies(root, robot, base_dir, _shapes, _geom)
     contact = ET.SubElement(root, "contact")
-    links = {link.name for link in robot.links}
-    for joint in robot.joints:
-        if joint.parent in links:
-            ET.SubElement(contact, "exclude", body1=joint.parent, body2=joint.child)
+    for a, b in sorted(_adjacent(robot)):  # the kit's rule: through links without geometry
+        ET.SubElement(contact, "exclude", body1=a, body2=b)
     return ET.tostring(root, encoding="unicode")
 
 
@@ -242,7 +242,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     if depth(q) > 0.0:
         feet = _feet_joints(robot, home, spec_path.parent)
         q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
-        if depth(q) > 0.0:
+        if depth(q) > TOUCH:  # not free: the first guess stays
             q = start
     support = _Support(robot, spec_path.parent)
     if support.margin(q) < MARGIN:
