@@ -287,6 +287,7 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
 
     start = np.array(home, dtype=float)
     q = start
+    support = _Support(robot, spec_path.parent)
     if depth(q) > 0.0:
         feet = _feet_joints(robot, home, spec_path.parent)
         q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
@@ -297,7 +298,6 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
             q = start
         elif always:  # "always" here may be "nearly always" to the kit's 10000 samples
             q = search(q, lambda t: (-depth(t), -every(t)), lambda b: b[1] >= 0.0, feet)
-    support = _Support(robot, spec_path.parent)
     if support.margin(q) < MARGIN:
         q = _resting(q, support, depth, movable, limits, index)
     changes = [
