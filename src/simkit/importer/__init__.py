@@ -60,6 +60,16 @@ def _step_budget(spec: dict, stage: Path, report: Report, doc) -> None:
         report.changed(doc, doc.root, why)
 
 
+def _up_axis(doc, mesh_writer, report: Report) -> None:
+    """Turn the URDF's Y_UP COLLADA meshes Z-up where its joints and inertials say they were
+    drawn so (up_axis.py); one report line either way when it has such meshes."""
+    from simkit.importer.up_axis import turn_y_up
+
+    mesh_writer.turn_y_up, why = turn_y_up(doc)
+    if why:
+        report.changed(doc, doc.root, why)
+
+
 def robot_name(path: Path) -> str:
     """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
     stem = path.name.split(".")[0].lower()
@@ -110,6 +120,7 @@ def import_robot(
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
         stage = Path(tmp)
         mesh_writer = meshes.MeshWriter(stage)
+        _up_axis(doc, mesh_writer, report)
         spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
         renames = names.make_legal(spec, doc, report)
         blocks.keep(spec, doc, report, blocks.collect(doc), renames)

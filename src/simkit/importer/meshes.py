@@ -97,6 +97,8 @@ class MeshWriter:
         self.out_dir = out_dir
         self.done: dict[tuple[str, tuple[float, ...]], MeshInfo] = {}
         self.names: set[str] = set()
+        #: COLLADA files marked Y_UP are turned Z-up (up_axis.turn_y_up decides per URDF)
+        self.turn_y_up = False
 
     def _name(self, path: Path, scale: tuple[float, float, float]) -> str:
         stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", path.stem) or "mesh"
@@ -121,6 +123,13 @@ class MeshWriter:
             mesh = _load(path)
         except Exception as exc:  # trimesh raises many types on bad files
             raise ValueError(f"cannot read mesh: {' '.join(str(exc).split())}") from None
+        if self.turn_y_up:
+            from simkit.importer.up_axis import Y_UP_TO_Z_UP, is_y_up
+
+            if is_y_up(path):
+                turn = np.eye(4)
+                turn[:3, :3] = Y_UP_TO_Z_UP
+                mesh.apply_transform(turn)
         mesh.apply_scale(np.asarray(scale, float))
         vertices, faces, repair = closed_solid(mesh)
         solid = trimesh.Trimesh(vertices, faces, process=False)

@@ -14,6 +14,7 @@ lowest point at home is on the floor) stay put: the stance is the standing check
 
 from __future__ import annotations
 
+import itertools
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -28,7 +29,11 @@ SAMPLES = 200  # random configurations that tell an always-touching pair
 FOOT = 0.01  # m: a link whose lowest point is this close to the robot's lowest is a foot
 SUPPORT = 0.003  # m: solid points this close to the lowest one touch the floor
 MARGIN = 0.01  # m: how far inside its support the CoM of a robot at rest must lie
-STABLE_SAMPLES = 2000  # random poses tried for one the robot rests on
+#: m: penetration the kit's self-collision check allows (simulate/self_collision.TOLERANCE)
+TOUCH = 0.0005
+STABLE_SAMPLES = 2000
+PAIR_JOINTS = 3  # joints next to a stuck pair moved two at a time
+PAIR_GRID = 24  # values per joint in that search  # random poses tried for one the robot rests on
 
 
 def _shapes(link) -> tuple:
@@ -183,6 +188,43 @@ def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
     return q
 
 
+def _better(got, best) -> bool:
+    """A score (a number, or a tuple compared in order) higher than `best` by more than
+    rounding."""
+    got, best = np.atleast_1d(got), np.atleast_1d(best)
+    for a, b in zip(got, best, strict=True):
+        if abs(a - b) > 1e-9:
+            return bool(a > b)
+    return False
+
+
+def _pair_search(q, depth, robot, model, data, adr, always, frozen, limits, index):
+    """For each link pair still in contact, the joints between them (distal first, the
+    first PAIR_JOINTS not frozen) two at a time over a PAIR_GRID x PAIR_GRID grid of their
+    ranges: the pose with the least `depth`. iCub's shoulder clears its chest only with
+    pitch and roll moved together."""
+    from simkit.importer.home import _between
+
+    movable = robot.movable_joints
+    best = depth(q)
+    for pair in sorted(p for p in _contacts(model, data, adr, q) if p not in always):
+        joints = [j for j in _between(robot, *pair) if j.name not in frozen][:PAIR_JOINTS]
+        for a, b in itertools.combinations(joints, 2):
+            ia, ib = index[a.name], index[b.name]
+            grid_a = np.linspace(*limits[ia], PAIR_GRID + 2)[1:-1]
+            grid_b = np.linspace(*limits[ib], PAIR_GRID + 2)[1:-1]
+            for va, vb in itertools.product(grid_a, grid_b):
+                trial = q.copy()
+                trial[ia], trial[ib] = va, vb
+                trial = _follow(trial[None, :], movable, index)[0]
+                got = depth(trial)
+                if got < best - 1e-9:
+                    q, best = trial, got
+            if best <= 0.0:
+                return q
+    return q
+
+
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) whose separable link pairs do not touch and on which the
     robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
@@ -214,7 +256,13 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     always = always or set()
 
     def depth(q) -> float:
-        return sum(d for p, d in _contacts(model, data, adr, q).items() if p not in always)
+        """m of penetration beyond TOUCH, summed over the separable pairs."""
+        found = _contacts(model, data, adr, q).items()
+        return sum(max(d - TOUCH, 0.0) for p, d in found if p not in always)
+
+    def every(q) -> float:
+        """m of penetration beyond TOUCH, summed over all pairs (the always ones too)."""
+        return sum(max(d - TOUCH, 0.0) for d in _contacts(model, data, adr, q).values())
 
     def search(q, score, done, frozen):
         """Greedy: one joint at a time (distal first) to the grid value that most improves
@@ -233,18 +281,23 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                     trial[i] = value
                     trial = _follow(trial[None, :], movable, index)[0]
                     got = score(trial)
-                    if got > best + 1e-9:
+                    if _better(got, best):
                         q, best = trial, got
         return q
 
     start = np.array(home, dtype=float)
     q = start
+    support = _Support(robot, spec_path.parent)
     if depth(q) > 0.0:
         feet = _feet_joints(robot, home, spec_path.parent)
         q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
-        if depth(q) > 0.0:
+        if depth(q) > 0.0:  # two joints at once for the pairs one cannot part
+            args = (robot, model, data, adr, always, feet, limits, index)
+            q = _pair_search(q, depth, *args)
+        if depth(q) > 0.0:  # not free: the first guess stays
             q = start
-    support = _Support(robot, spec_path.parent)
+        elif always:  # "always" here may be "nearly always" to the kit's 10000 samples
+            q = search(q, lambda t: (-depth(t), -every(t)), lambda b: b[1] >= 0.0, feet)
     if support.margin(q) < MARGIN:
         q = _resting(q, support, depth, movable, limits, index)
     changes = [
