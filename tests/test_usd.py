@@ -242,3 +242,20 @@ def test_passive_springs_are_drives(kit_factory, tmp_path):
     assert text.count(old) == 2
     (copy / "usd/asimov.usda").write_text(text.replace(old, old.replace("0.0785", "0.0885")))
     assert "usd.drive.stiffness" in {f.check for f in check_usd(Kit.open(copy)) if not f.ok}
+
+
+@pytest.mark.parametrize("angle", [3.8e-6, 1e-4, 0.01, 0.3, 3.14159])
+def test_orient_keeps_small_turns_as_usd_reads_them(angle):
+    """USD reads an orient quaternion's angle from its real part (2 acos w): a link turned
+    3.8e-6 rad (iCub's r_elbow_1) must not come back unturned."""
+    from pxr import Usd, UsdGeom
+
+    from simkit.emit.usd import _place
+    from simkit.model.kinematics import rpy_matrix
+
+    rot = rpy_matrix((0.0, angle, 0.5 * angle))
+    stage = Usd.Stage.CreateInMemory()
+    prim = UsdGeom.Xform.Define(stage, "/link").GetPrim()
+    _place(prim, (0.1, 0.0, 0.0), rot)
+    world = np.array(UsdGeom.XformCache().GetLocalToWorldTransform(prim)).T
+    assert np.abs(world[:3, :3] - rot).max() < 1e-8

@@ -51,10 +51,23 @@ def _r(values: Sequence[float]) -> list[float]:
     return [rounded(v) for v in values]
 
 
+#: rad: the largest error allowed in the angle USD reads from a written orient quaternion
+#: (10 digits of w keep turns above about 0.02 rad within it)
+ANGLE_TOL = 1e-8
+
+
 def _quat(rot: np.ndarray):
+    """An orient quaternion as USD reads it back. USD takes the angle from the real part
+    (GfRotation: 2 acos w), so for a small turn 10 digits of w lose it: iCub's r_elbow_1 sits
+    3.8e-6 rad off its parent's frame, w = 1 - 1.8e-12 was written as 1, and USD placed the
+    link 6.6e-6 off its joint. There, and only there, w keeps 17 digits."""
     from pxr import Gf
 
-    w, x, y, z = _r(quat_wxyz(rot))
+    exact = quat_wxyz(rot)
+    w, x, y, z = _r(exact)
+    angle = 2.0 * math.atan2(float(np.linalg.norm(exact[1:])), abs(float(exact[0])))
+    if abs(2.0 * math.acos(min(1.0, abs(w))) - angle) > ANGLE_TOL:
+        w = rounded(float(exact[0]), 17)
     return Gf.Quatd(w, Gf.Vec3d(x, y, z))
 
 
