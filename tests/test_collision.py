@@ -51,7 +51,7 @@ def test_distance_to_surface_matches_a_box():
         np.linalg.norm(np.maximum(np.abs(points) - 1, 0), axis=1),
     )
     for k in range(0, 400, 40):
-        got = collision.max_distance_to_surface(points[k : k + 40], box, block=16)
+        got = collision.max_distance_to_surface(points[k : k + 40], box)
         assert got == pytest.approx(exact[k : k + 40].max(), abs=1e-12)
 
 
@@ -162,3 +162,15 @@ def test_coacd_cached_warm_runs_none_and_corrupt_entries_are_repaired(tmp_path):
     assert _pieces(repaired) == _pieces(cold)  # seeded CoACD: the same pieces again
     for name in ("base_link", "bracket"):
         assert Cache.at(tmp_path / "cache").get(linkwork.COLLISION_STEP, keys[name]) is not None
+
+
+def test_outside_depth_by_cells_is_every_plane_at_once():
+    """The grid culling keeps, for each point, the plane that gives its maximum."""
+    rng = np.random.default_rng(3)
+    hull = to_mesh(mf.Manifold.hull_points(rng.normal(size=(3000, 3))))
+    points = rng.uniform(-3.0, 3.0, size=(60_000, 3))
+    n, d = collision._halfspaces(hull)
+    assert len(points) * len(d) > collision.CHUNK  # the cell path, not the small one
+    brute = (points @ n.T - d).max(axis=1)
+    got = collision.outside_depth(points, hull)
+    assert np.abs(got - brute).max() < 1e-14

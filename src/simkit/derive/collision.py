@@ -19,6 +19,7 @@ per link, link frame, metres.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 
 import numpy as np
@@ -48,6 +49,8 @@ COACD_PARAMS: dict[str, object] = {
 }
 COARSE_TOLERANCE = 0.0005  # m: manifold `simplify` tolerance for the coarse CoACD input
 COARSE_MAX_TRIANGLES = 5000  # issue 3: CoACD input of 2.5k to 5k triangles
+#: grid cells per side for `outside_depth`'s plane culling
+CELLS = 24
 INSIDE_TOL = 1e-7  # m: a point this close to a hull's face counts as inside
 #: Runs of CoACD in this process, plus those reported back by pool workers (tests count them).
 COACD_RUNS = 0
@@ -233,17 +236,39 @@ def _halfspaces(hull: Mesh) -> tuple[np.ndarray, np.ndarray]:
 
 
 def outside_depth(points: np.ndarray, hull: Mesh) -> np.ndarray:
-    """How far each point lies outside a convex mesh (max face-plane distance; <= 0 inside)."""
+    """How far each point lies outside a convex mesh (max face-plane distance; <= 0 inside).
+
+    Exact, cell by cell: the points are binned in a grid of `CELLS` per side, and for a cell
+    of radius r about c a face plane can give a point its maximum only if its distance at c
+    plus r reaches the largest distance at c minus r. A detailed hull (SO-101's base, 9,000
+    faces, against 100,000 surface samples) drops from every plane for every point (66 s on 2
+    cores) to the few planes facing each cell."""
     n, d = _halfspaces(hull)
-    # in blocks of points: a detailed hull (SO-101's base, 9000 faces) against 100 000
-    # surface samples is a 7 GB matrix at once; the same maxima, block by block
+    if not len(points):
+        return np.zeros(0)
+    if len(points) * len(d) <= CHUNK:
+        return _plane_max(points, n, d)
+    lo = points.min(axis=0)
+    size = max(float((points.max(axis=0) - lo).max()) / CELLS, 1e-9)
+    keys = np.floor((points - lo) / size).astype(np.int64)
+    cells, owner = np.unique(keys, axis=0, return_inverse=True)
+    order = np.argsort(owner.ravel(), kind="stable")
+    bounds = np.searchsorted(owner.ravel()[order], np.arange(len(cells) + 1))
+    out = np.empty(len(points))
+    radius = size * math.sqrt(3.0) / 2.0
+    for k, key in enumerate(cells):
+        members = order[bounds[k] : bounds[k + 1]]
+        at_centre = n @ (lo + (key + 0.5) * size) - d
+        keep = at_centre + radius >= at_centre.max() - radius - 1e-12
+        out[members] = _plane_max(points[members], n[keep], d[keep])
+    return out
+
+
+def _plane_max(points: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """max over planes of n . p - d for each point, in blocks of at most `CHUNK` entries."""
     rows = max(1, CHUNK // max(len(d), 1))
-    return (
-        np.concatenate(
-            [(points[i : i + rows] @ n.T - d).max(axis=1) for i in range(0, len(points), rows)]
-        )
-        if len(points)
-        else np.zeros(0)
+    return np.concatenate(
+        [(points[i : i + rows] @ n.T - d).max(axis=1) for i in range(0, len(points), rows)]
     )
 
 
@@ -297,40 +322,41 @@ def _point_triangle_distance(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     return np.where(inside, plane, edges)
 
 
-def max_distance_to_surface(
-    points: np.ndarray, surface: Mesh, block: int = 256, nearest: int = 4
-) -> float:
+def max_distance_to_surface(points: np.ndarray, surface: Mesh, nearest: int = 4) -> float:
     """Largest distance from `points` to the triangle surface `surface` (m), exact.
 
-    Per block of points: the distance to each triangle's bounding box is a lower bound; exact
-    distances to the `nearest` triangles by that bound give each point an upper bound; points
-    whose bound cannot beat the running maximum are done, and the rest are compared with every
-    triangle whose lower bound is within their upper bound."""
+    Every triangle lies in the ball about its centroid through its farthest corner, so
+    |p - centroid| - radius is a lower bound. The `nearest` triangles by centroid (a KD-tree)
+    give each point an upper bound; points are taken by that bound, largest first, each one
+    compared exactly with every triangle whose lower bound is within its upper bound, and
+    the walk stops at the first point whose upper bound cannot beat the maximum so far.
+    (It replaced a points x triangles bound matrix: SO-101's base took 77 s, on 2 cores.)"""
+    from scipy.spatial import cKDTree
+
+    if not len(points):
+        return 0.0
     tri = surface.vertices[surface.faces]
-    lo, hi = tri.min(axis=1), tri.max(axis=1)
+    centre = tri.mean(axis=1)
+    radius = np.linalg.norm(tri - centre[:, None, :], axis=2).max(axis=1)
+    tree = cKDTree(centre)
     k = min(nearest, len(tri))
-    worst = 0.0
-    for start in range(0, len(points), block):
-        p = points[start : start + block]
-        lower = np.zeros((len(p), len(tri)))
-        for axis in range(3):  # squared distance to the box, one axis at a time
-            gap = np.maximum(
-                lo[None, :, axis] - p[:, None, axis], p[:, None, axis] - hi[None, :, axis]
-            )
-            np.maximum(gap, 0, out=gap)
-            lower += gap * gap
-        np.sqrt(lower, out=lower)
-        first = np.argpartition(lower, k - 1, axis=1)[:, :k]
-        rows = np.repeat(np.arange(len(p)), k)
-        upper = _point_triangle_distance(p[rows], tri[first.ravel()]).reshape(len(p), k).min(axis=1)
-        todo = np.nonzero(upper > worst)[0]
-        if len(todo) == 0:
-            continue
-        rows, cols = np.nonzero(lower[todo] < upper[todo, None])
-        best = upper[todo].copy()
-        if len(rows):
-            np.minimum.at(best, rows, _point_triangle_distance(p[todo][rows], tri[cols]))
-        worst = max(worst, float(best.max()))
+    _dist, first = tree.query(points, k=k)
+    first = np.asarray(first).reshape(len(points), k)
+    rows = np.repeat(np.arange(len(points)), k)
+    upper = _point_triangle_distance(points[rows], tri[first.ravel()]).reshape(-1, k).min(axis=1)
+    worst, slack, reach = 0.0, 1e-9, float(radius.max())
+    for i in np.argsort(-upper, kind="stable"):
+        if upper[i] <= worst:
+            break  # every point left has a smaller upper bound
+        near = np.asarray(tree.query_ball_point(points[i], upper[i] + reach + slack), dtype=int)
+        near = near[
+            np.linalg.norm(centre[near] - points[i], axis=1) - radius[near] <= upper[i] + slack
+        ]
+        best = upper[i]
+        if len(near):
+            exact = _point_triangle_distance(np.repeat(points[i : i + 1], len(near), 0), tri[near])
+            best = min(best, float(exact.min()))
+        worst = max(worst, float(best))
     return worst
 
 
