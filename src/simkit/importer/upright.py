@@ -4,9 +4,10 @@ A URDF's free joint is implicit, so the importer starts the base at the identity
 legged robots are drawn Z-up, their limbs hanging along -z; a few are drawn Y-up
 (human.urdf, a biomechanics model: knees and ankles 0.44 m along -y, the spine along +y), and
 at the identity they lie on their side and roll over. The limbs decide: from each branch
-leaving the base frame, the farthest end of its movable chains (a foot, a hand, the head),
-summed in the base frame. Where that sum points along one axis direction other than -z, and
-the robot's joints spread at least twice as far along that axis as along z (a robot lying
+leaving the base frame, the farthest end of its movable chains (a foot, a hand, the head: the
+CoM of the last link), summed in the base frame. Where that sum points along one axis
+direction other than -z, and the links' CoMs spread at least twice as far along that axis as
+along z (a robot lying
 down, not a flat drone), the base is turned so that direction points down. Reported.
 """
 
@@ -29,6 +30,17 @@ DIRECTIONS = {
 SPREAD = 2.0  # how much farther the joints spread along the limbs' axis than along z
 
 
+def points(robot, poses: dict, base: str) -> dict[str, np.ndarray]:
+    """Each link's CoM (its origin without an inertial) and each frame's origin, in the
+    base frame (m): a limb's reach, not just its joints (a short hip joint, a long leg)."""
+    inverse = np.linalg.inv(poses[base])
+    com = {link.name: link.inertial.com for link in robot.links if link.inertial is not None}
+    return {
+        name: (inverse @ pose @ np.append(com.get(name, (0.0, 0.0, 0.0)), 1.0))[:3]
+        for name, pose in poses.items()
+    }
+
+
 def limb_ends(robot, poses: dict, base: str) -> np.ndarray:
     """Sum (m, base frame) over the branches leaving the base's welded frame of the farthest
     child of a movable joint with no movable joint below it."""
@@ -49,8 +61,7 @@ def limb_ends(robot, poses: dict, base: str) -> np.ndarray:
             out += [joint] if joint.movable else firsts(joint.child)
         return out
 
-    inverse = np.linalg.inv(poses[base])
-    at = {name: (inverse @ pose)[:3, 3] for name, pose in poses.items()}
+    at = points(robot, poses, base)
     total = np.zeros(3)
     for joint in firsts(base):
         names = ends(joint.child) or [joint.child]
@@ -78,15 +89,14 @@ def upright(spec_path: Path) -> tuple[tuple[float, float, float], str] | None:
     direction, rpy = DIRECTIONS[name]
     if name == "-z" or float(direction @ total) <= 0.0:
         return None
-    inverse = np.linalg.inv(poses[floating.child])
-    points = np.array([(inverse @ pose)[:3, 3] for pose in poses.values()])
-    spread = points.max(axis=0) - points.min(axis=0)
+    reach = np.array(list(points(robot, poses, floating.child).values()))
+    spread = reach.max(axis=0) - reach.min(axis=0)
     axis = int(np.argmax(np.abs(direction)))
     if spread[axis] < SPREAD * spread[2]:
         return None
     why = (
         f"floating base turned rpy {rpy[0]:.4g} {rpy[1]:.4g} {rpy[2]:.4g} rad: its limbs "
-        f"(feet, hands, head) point along {name} in the URDF ({spread[axis]:.3g} m of joints "
+        f"(feet, hands, head) point along {name} in the URDF ({spread[axis]:.3g} m of links "
         f"along it, {spread[2]:.3g} m along z); turned so that {name} points down"
     )
     return rpy, why
