@@ -101,6 +101,9 @@ def check_models(kit: Kit) -> list[Finding]:
     dmj, dur = mujoco.MjData(mj), mujoco.MjData(ur)
     qa, qb = _qpos_indices(mj, names), _qpos_indices(ur, names)
     va, vb = _dof_indices(mj, names), _dof_indices(ur, names)
+    for j in range(mj.njnt):  # the URDF's base is the world frame: the free joint there too
+        if mj.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+            dmj.qpos[mj.jnt_qposadr[j] + 3 : mj.jnt_qposadr[j] + 7] = (1.0, 0.0, 0.0, 0.0)
     pos_mj, pos_ur, pos_json, tau_mj, tau_ur = [], [], [], [], []
     rot_mj, rot_ur, rot_json = [], [], []
     for q in configs:

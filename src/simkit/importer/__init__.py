@@ -31,15 +31,20 @@ class Imported:
 def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
     """Move home out of self-contact and onto a stance it rests on (`_free_stance`), raise
     the floating base so the robot stands on the floor at home; rewrite the spec."""
-    from simkit.importer import standing, writer
+    from simkit.importer import standing, upright, writer
 
+    joint = spec["joints"][0]
+    turned = upright.upright(spec_path)
+    if turned is not None:  # a Y-up robot lies on its side at the identity
+        joint["rpy"], joint["estimated"] = [float(f"{v:.6g}") for v in turned[0]], ["rpy"]
+        report.assumed(doc, doc.root, turned[1])
+        spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
     _free_stance(spec, report, doc, spec_path, path)
     height = standing.standing_height(spec_path)
     if height is None:
         return spec_path.read_text(encoding="utf-8")
-    joint = spec["joints"][0]
     joint["xyz"] = [0.0, 0.0, float(f"{height:.6f}")]
-    joint["estimated"] = ["xyz"]
+    joint["estimated"] = sorted({*joint.get("estimated", []), "xyz"})
     report.changed(
         doc,
         doc.root,

@@ -146,7 +146,10 @@ def convert(
             load = _load(source, link_name, links, kids, by_child)
             spec_joints.append(joint_spec(source, by_child[link_name], report, load))
     if floating and source.root.find("link/collision") is None:
-        _visual_collision(source, spec_links, report)
+        if source.root.find("link/visual") is None:
+            _estimated_solids(source, spec_links, spec_joints, report)
+        else:
+            _visual_collision(source, spec_links, report)
     if floating and has_mass(links[root]) is False and not has_geometry(links[root]):
         report.changed(source, links[root], "massless root of a floating base")
     spec: dict = {
@@ -202,6 +205,23 @@ def _visual_collision(source: Source, spec_links: list[dict], report: Report) ->
             source.root,
             f"no <collision> in the URDF: {done} links collide with their visual solid's "
             "convex hull (a floating base needs something to stand on)",
+        )
+
+
+def _estimated_solids(source: Source, links: list[dict], joints: list[dict], report) -> None:
+    """A floating robot with no geometry at all (simple_humanoid_classical.urdf) gets an
+    estimated box per link with a mass (solids.py), reported on one line."""
+    from simkit.importer.solids import DENSITY, MAX_SIDE, add_solids
+
+    done = add_solids(links, joints)
+    if done:
+        report.estimated(
+            source,
+            source.root,
+            f"no <visual> or <collision> in the URDF: {done} links with a mass get a box "
+            f"spanning their origin, child joints and CoM, as thick as holds the mass at "
+            f"{DENSITY:g} kg/m^3 up to {MAX_SIDE:g} m (solid and collision; a floating base "
+            "needs something to stand on)",
         )
 
 

@@ -225,6 +225,17 @@ def _pair_search(q, depth, robot, model, data, adr, always, frozen, limits, inde
     return q
 
 
+def _alike(q, depth, robot, index, movable) -> np.ndarray:
+    """alike.group_search from `q`, mimic joints following."""
+    from simkit.importer.alike import group_search
+    from simkit.model.kinematics import forward
+
+    poses = forward(robot, list(q))
+    return group_search(
+        q, depth, robot, poses, index, lambda t: _follow(t[None, :], movable, index)[0]
+    )
+
+
 def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) whose separable link pairs do not touch and on which the
     robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
@@ -294,6 +305,8 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
         if depth(q) > 0.0:  # two joints at once for the pairs one cannot part
             args = (robot, model, data, adr, always, feet, limits, index)
             q = _pair_search(q, depth, *args)
+        if depth(q) > 0.0:  # alike joints of all limbs together, feet kept level (HyQ)
+            q = _alike(q, depth, robot, index, movable)
         if depth(q) > 0.0:  # not free: the first guess stays
             q = start
         elif always:  # "always" here may be "nearly always" to the kit's 10000 samples

@@ -34,6 +34,26 @@ def _points(shape, base_dir: Path) -> np.ndarray:
     return local @ rpy_matrix(shape.rpy).T + np.asarray(shape.xyz)
 
 
+def _lowest(shape, pose: np.ndarray, base_dir: Path) -> float:
+    """World z (m) of a shape's lowest point with its link at `pose`: exact for round shapes
+    (a tilted shin cylinder's bounding-box corners reach below the cylinder: HyQ with its
+    hips spread stood 1.7 cm above the floor), the lowest vertex or corner otherwise."""
+    from simkit.model.kinematics import rpy_matrix
+
+    if shape.kind not in ("sphere", "cylinder", "capsule"):
+        world = _points(shape, base_dir) @ pose[:3, :3].T + pose[:3, 3]
+        return float(world[:, 2].min())
+    rotation = pose[:3, :3] @ rpy_matrix(shape.rpy)
+    centre = pose[:3, :3] @ np.asarray(shape.xyz) + pose[:3, 3]
+    if shape.kind == "sphere":
+        return float(centre[2] - shape.radius)
+    axis = rotation[:, 2]
+    end = float(centre[2] - abs(axis[2]) * shape.length / 2)
+    if shape.kind == "capsule":
+        return end - shape.radius
+    return end - shape.radius * float(np.sqrt(max(0.0, 1.0 - axis[2] ** 2)))
+
+
 def floor_shapes(link) -> tuple:
     """What of a link can touch the floor in the kit: its collision primitives or given
     collision shapes where the spec has them (HyQ's shin is a 2 cm cylinder inside a wider
@@ -63,8 +83,6 @@ def standing_height(spec_path: Path) -> float | None:
     touching = any(floor_shapes(link) for link in robot.links)
     for link in robot.links:
         for shape in floor_shapes(link) if touching else link.shapes:
-            pts = _points(shape, spec_path.parent)
-            world = pts @ poses[link.name][:3, :3].T + poses[link.name][:3, 3]
-            z = float(world[:, 2].min())
+            z = _lowest(shape, poses[link.name], spec_path.parent)
             lowest = z if lowest is None else min(lowest, z)
     return None if lowest is None else -lowest
