@@ -210,6 +210,6 @@ def test_outside_depth_in_blocks_is_the_same_as_at_once(monkeypatch):
     hull = to_mesh(mf.Manifold.sphere(0.1, 48))
     points = np.random.default_rng(0).uniform(-0.2, 0.2, (1000, 3))
     n, d = collision._halfspaces(hull)
-    whole = (points @ n.T - d).max(axis=1)
+    whole = collision.plane_values(points, n, d).max(axis=1)
     monkeypatch.setattr(collision, "CHUNK", 7 * len(d))  # 7 points a block
     assert np.array_equal(collision.outside_depth(points, hull), whole)

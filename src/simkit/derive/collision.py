@@ -264,11 +264,18 @@ def outside_depth(points: np.ndarray, hull: Mesh) -> np.ndarray:
     return out
 
 
+def plane_values(points: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """n . p - d for every point (rows) and plane (columns), term by term: each entry is the
+    same float however the points and planes are split (a matrix product's rounding depends
+    on the kernel BLAS picks for the shape)."""
+    return points[:, :1] * n[:, 0] + points[:, 1:2] * n[:, 1] + points[:, 2:3] * n[:, 2] - d
+
+
 def _plane_max(points: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray:
     """max over planes of n . p - d for each point, in blocks of at most `CHUNK` entries."""
     rows = max(1, CHUNK // max(len(d), 1))
     return np.concatenate(
-        [(points[i : i + rows] @ n.T - d).max(axis=1) for i in range(0, len(points), rows)]
+        [plane_values(points[i : i + rows], n, d).max(axis=1) for i in range(0, len(points), rows)]
     )
 
 
