@@ -13,9 +13,11 @@ The load is the spec's own: masses, CoMs and axes through simkit's Newton-Euler
 (multiplier x load, as the MJCF's equality holds it). Where some joint is over `LIMIT`, the
 joints over `AIM` and every non-mimic joint they carry move one at a time to the grid value
 that lowers the summed excess over `AIM` most (the arm hangs, or folds), nearest the current
-value on a tie, never at a limit, and never into more self-contact than home has (home.py's
-model with the visual pieces the kit's collision covers, limits.py). Effort numbers are
-never changed.
+value on a tie, never at a limit, never bringing two links closer than the clearance (or
+than at home, where they are closer there) on home.py's model with the visual pieces the
+kit's collision covers (limits.py). Where no such move is free, one joint above them may
+move too (PR2's torso rises so a lowered arm clears the base). Effort numbers are never
+changed.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ LIMIT = 0.8
 AIM = 0.5
 GRID = 24  # range divisions tried per joint
 SWEEPS = 3  # moves per joint at most
+ROOM = 4  # the best moves that may also move a joint above them, when none is free alone
+GAIN = 0.005  # the least cost a move must save (no turns for a wrist roll's 0.1 %)
 
 
 def _loads(robot, tree, q: np.ndarray) -> tuple[np.ndarray, list[int]]:
@@ -101,7 +105,7 @@ class _Search:
 
     def open(self) -> None:
         """The collision model (home.py's, with the visual pieces, limits.py) and the
-        self-contact (m, summed) at the start that no trial may exceed."""
+        closest distance (m) of each pair of links near each other at the start."""
         from simkit.importer import home, limits
 
         always = home._always_touching(self.robot, self.spec_dir, self.start, self.follow)
@@ -111,16 +115,22 @@ class _Search:
         self.adr = np.array(
             [self.model.jnt_qposadr[self.model.joint(j.name).id] for j in self.movable], int
         )
-        self.depth = self._depth(self.start)
+        self.near = self._closest(self.start)
 
-    def _depth(self, q: np.ndarray) -> float:
-        from simkit.importer import home
+    def _closest(self, q: np.ndarray) -> dict:
+        from simkit.importer import limits
 
-        return home._penetration(self.model, self.data, self.adr, q)[0]
+        return limits._closest(self.model, self.data, self.adr, q)
 
     def free(self, q: np.ndarray) -> bool:
-        """No more self-contact than at the start."""
-        return self._depth(q) <= self.depth + 1e-9
+        """No pair of links closer than the clearance, or than at the start where they were
+        closer already (the kit's collision pieces are not the search's)."""
+        from simkit.importer.home import CLEARANCE
+
+        return all(
+            dist >= min(CLEARANCE, self.near.get(pair, np.inf)) - 1e-6
+            for pair, dist in self._closest(q).items()
+        )
 
     def loads(self, q: np.ndarray) -> np.ndarray:
         return _loads(self.robot, self.tree, q)[0]
@@ -142,21 +152,19 @@ class _Search:
         for joint in joints:
             for value in _grid(joint, q[self.index[joint.name]]):
                 trial = self.moved(q, joint, value)
-                if trial is not None and (cost := self.cost(trial)) < best - 1e-9:
+                if trial is not None and (cost := self.cost(trial)) < best - GAIN:
                     found.append((cost, float(np.abs(trial - q).sum()), trial))
         found.sort(key=lambda f: f[:2])
         return [t for _, _, t in found]
 
     def room(self, trial: np.ndarray, lift: list, best: float) -> np.ndarray | None:
-        """`trial` if free, else with one joint of `lift` moved (nearest value first) so
+        """`trial` with one joint of `lift` moved (nearest value first) so
         that it is free and still below `best`: a torso raised so a lowered arm clears the
         base. None when no such move exists."""
-        if self.free(trial):
-            return trial
         for joint in lift:
             for value in _grid(joint, trial[self.index[joint.name]]):
                 out = self.moved(trial, joint, value)
-                if out is not None and self.cost(out) < best - 1e-9 and self.free(out):
+                if out is not None and self.cost(out) < best - GAIN and self.free(out):
                     return out
         return None
 
@@ -178,8 +186,9 @@ def held_home(spec_path: Path) -> tuple[list[float], list[str], str] | None:
     for _ in range(SWEEPS * len(search.movable)):
         over = {search.movable[acting[k]].name for k in np.flatnonzero(search.loads(q) > AIM)}
         lift = _above(search.robot, over)
-        move = None
-        for trial in search.better(q, best, _carried(search.robot, over)):
+        found = search.better(q, best, _carried(search.robot, over))
+        move = next((t for t in found if search.free(t)), None)
+        for trial in found[:ROOM] if move is None else ():
             if (move := search.room(trial, lift, best)) is not None:
                 break
         if move is None:
