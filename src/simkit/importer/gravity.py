@@ -15,9 +15,9 @@ joints over `AIM` and every non-mimic joint they carry move one at a time to the
 that lowers the summed excess over `AIM` most (the arm hangs, or folds), nearest the current
 value on a tie, never at a limit, never bringing two links closer than the clearance (or
 than at home, where they are closer there) on home.py's model with the visual pieces the
-kit's collision covers (limits.py). Where no such move is free, one joint above them may
-move too (PR2's torso rises so a lowered arm clears the base). Effort numbers are never
-changed.
+kit's collision covers (limits.py). Where no such move is free, one other joint, above
+them or below, may move too (PR2's torso rises so a lowered arm clears the base). Effort
+numbers are never changed.
 """
 
 from __future__ import annotations
@@ -117,13 +117,21 @@ class _Search:
         )
         self.near = self._closest(self.start)
 
-    def _closest(self, q: np.ndarray) -> dict:
-        from simkit.importer import limits
+    def _closest(self, q: np.ndarray) -> dict[tuple[int, int], float]:
+        """The smallest distance (m) per pair of geoms closer than the clearance at `q` (per
+        geom, not per link: a link's visual piece overlapping at home must not let its
+        collision piece sink in)."""
+        from simkit.importer import home
 
-        return limits._closest(self.model, self.data, self.adr, q)
+        home._penetration(self.model, self.data, self.adr, q)
+        out: dict[tuple[int, int], float] = {}
+        for contact in self.data.contact[: self.data.ncon]:
+            pair = (int(contact.geom[0]), int(contact.geom[1]))
+            out[pair] = min(out.get(pair, np.inf), float(contact.dist))
+        return out
 
     def free(self, q: np.ndarray) -> bool:
-        """No pair of links closer than the clearance, or than at the start where they were
+        """No pair of geoms closer than the clearance, or than at the start where they were
         closer already (the kit's collision pieces are not the search's)."""
         from simkit.importer.home import CLEARANCE
 
@@ -185,8 +193,9 @@ def held_home(spec_path: Path) -> tuple[list[float], list[str], str] | None:
     q, best = start.copy(), _cost(ratios)
     for _ in range(SWEEPS * len(search.movable)):
         over = {search.movable[acting[k]].name for k in np.flatnonzero(search.loads(q) > AIM)}
-        lift = _above(search.robot, over)
-        found = search.better(q, best, _carried(search.robot, over))
+        carried = _carried(search.robot, over)
+        lift = _above(search.robot, over) + carried
+        found = search.better(q, best, carried)
         move = next((t for t in found if search.free(t)), None)
         for trial in found[:ROOM] if move is None else ():
             if (move := search.room(trial, lift, best)) is not None:
