@@ -83,11 +83,15 @@ def robot_name(path: Path) -> str:
 
 
 def _free_home(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
-    """Move a fixed-base robot's `home` out of self-contact (home.py); rewrite the spec."""
-    from simkit.importer import home
+    """Move a fixed-base robot's `home` out of self-contact (home.py), then to where its
+    servos can hold it against gravity (gravity.py); rewrite the spec."""
+    from simkit.importer import gravity, home
 
     why = "the links collide at the first guess (0, or mid-range outside the limits)"
     _new_home(home.free_home(spec_path), why, spec, report, doc, spec_path, path)
+    held = gravity.held_home(spec_path)
+    if held is not None:
+        _new_home(held[:2], held[2], spec, report, doc, spec_path, path)
 
 
 def _new_home(found, why: str, spec: dict, report: Report, doc, spec_path: Path, path: Path):

@@ -183,7 +183,7 @@ def _contacts(model, data, adr, q) -> set[tuple[str, str]]:
     return out
 
 
-def _always_touching(robot, base_dir: Path, start: np.ndarray, follow) -> tuple:
+def _always_touching(robot, base_dir: Path, start: np.ndarray, follow, shapes_of=_shapes) -> tuple:
     """Link pairs touching at the first guess and in at least `ALWAYS_FRACTION` of
     `ALWAYS_SAMPLES` seeded random configurations: URDF collision shapes that overlap wherever
     (or almost wherever) the joints are (Panda collision primitives of links 1 and 3, TIAGo's
@@ -193,7 +193,7 @@ def _always_touching(robot, base_dir: Path, start: np.ndarray, follow) -> tuple:
     could fix."""
     import mujoco
 
-    model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir))
+    model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir, shapes_of=shapes_of))
     data = mujoco.MjData(model)
     movable = robot.movable_joints
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
@@ -248,22 +248,41 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
     or None when the spec's home is already free or the search finds no free pose. Only the
     joints between two links in contact move, each to the grid value that leaves the least
-    penetration, the one nearest the first guess on a tie."""
-    import mujoco
+    penetration, the one nearest the first guess on a tie. A second search, from the first
+    one's pose, adds the links' visual pieces (limits.py), which the kit's collision pieces
+    are grown to cover (Alex's Sake fingers, whose collision meshes sit apart from their
+    visual ones, touch only there)."""
+    from simkit.importer import limits
 
     robot, start, follow = load(spec_path)
     if start is None:  # no movable joint: nothing to move
         return None
+    q = start
+    for shapes_of in (_shapes, limits._shapes):
+        q = _search(robot, spec_path.parent, q, follow, shapes_of)
+    changes = [
+        f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
+        for i, j in enumerate(robot.movable_joints)
+        if abs(q[i] - start[i]) > 1e-12
+    ]
+    return ([float(f"{v:.6g}") for v in q], changes) if changes else None
+
+
+def _search(robot, base_dir: Path, start: np.ndarray, follow, shapes_of) -> np.ndarray:
+    """A pose free of contact on the model of `shapes_of`, from `start` (see free_home);
+    `start` when it is free already or no free pose is found."""
+    import mujoco
+
     movable = robot.movable_joints
     index = {j.name: i for i, j in enumerate(movable)}
-    always = _always_touching(robot, spec_path.parent, start, follow)
-    model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent, always))
+    always = _always_touching(robot, base_dir, start, follow, shapes_of)
+    model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir, always, shapes_of))
     data = mujoco.MjData(model)
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
     q = start.copy()
     best, pairs = _penetration(model, data, adr, q)
     if not _touching(data):  # closer than the clearance is fine at the first guess
-        return None
+        return start
     for _ in range(SWEEPS * len(movable)):
         joints = {j.name: j for a, b in sorted(pairs) for j in _between(robot, a, b)}
         moved = False
@@ -286,11 +305,4 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
         if best == 0.0 or not moved:
             break
     _penetration(model, data, adr, q)
-    if _touching(data):  # no free pose found: the first guess stays
-        return None
-    changes = [
-        f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
-        for i, j in enumerate(movable)
-        if abs(q[i] - start[i]) > 1e-12
-    ]
-    return [float(f"{v:.6g}") for v in q], changes
+    return start if _touching(data) else q  # no free pose found: the first guess stays
