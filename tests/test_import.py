@@ -217,6 +217,8 @@ def test_imported_arm_builds(tmp_path, kit_factory):
     text = urdf.read_text()
     spec, _doc = load_spec(done.spec_path)
     assert all(block in text for block in spec.urdf_blocks)
+    mjcf = next(result.kit_dir.glob("mjcf/*.xml")).read_text()  # the mimic's stiff equality
+    assert 'joint1="spin_follow" joint2="spin"' in mjcf and 'solref="0.004 1"' in mjcf
     kit = tmp_path / "kit"
     shutil.copytree(result.kit_dir, kit)
     found = {f.check: f.ok for f in check_urdf(Kit.open(kit))}
