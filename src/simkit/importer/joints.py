@@ -176,7 +176,7 @@ def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> N
     tol = 1e-9 * max(1.0, abs(lower), abs(upper))
     if lower >= joint["lower"] - tol and upper <= joint["upper"] + tol:
         return
-    element = source.root.find(f"joint[@name='{joint['name']}']/limit")
+    element = source.root.find(f"joint[@name='{joint['name']}']")
     report.estimated(
         source,
         element if element is not None else source.root,
