@@ -91,3 +91,59 @@ def test_home_clears_visual_pieces_the_collision_leaves_apart(tmp_path):
     # clear of the post: the visual's far corners (0.3 m out, 0.02 m wide) miss its 0.025 m
     assert abs(home[0]) > np.arctan2(0.045, 0.275)
     assert any("home:" in line and "yaw: 0 ->" in line for line in lines)
+
+
+def test_search_lets_a_pair_overlapping_at_the_start_go_a_little_deeper():
+    # Baxter's elbow: the hulls of two visual pieces overlap by 48 mm at the start and by
+    # 0.1 mm more as the elbow folds; the kit's pieces, which follow the mesh, stay apart
+    search = object.__new__(gravity._Search)
+    search.near = {(0, 1): -0.048, (2, 3): 0.01}
+    assert search._allowed((0, 1), -0.048 - 0.0001)
+    assert not search._allowed((0, 1), -0.048 - 2 * gravity.SLACK)
+    assert search._allowed((2, 3), 0.003)  # apart at the start: the clearance, no slack
+    assert not search._allowed((2, 3), 0.003 - gravity.SLACK / 2)
+    assert not search._allowed((4, 5), 0.0)  # a new pair inside the clearance
+
+
+def _gripper(multiplier: float, lower: float, upper: float) -> str:
+    """A finger on a 0..0.5 rad leader and a follower mimicking it with `multiplier` whose
+    URDF limits are `lower`..`upper`."""
+    follower = (
+        '<joint name="follow" type="revolute"><parent link="base"/><child link="f2"/>'
+        '<origin xyz="-0.1 0 0.1"/><axis xyz="0 1 0"/>'
+        f'<limit lower="{lower}" upper="{upper}" effort="5" velocity="2"/>'
+        f'<mimic joint="lead" multiplier="{multiplier}" offset="0"/></joint>'
+    )
+    leader = (
+        '<joint name="lead" type="revolute"><parent link="base"/><child link="f1"/>'
+        '<origin xyz="0.1 0 0.1"/><axis xyz="0 1 0"/>'
+        '<limit lower="0" upper="0.5" effort="5" velocity="2"/></joint>'
+    )
+    return "\n".join(
+        [
+            _link("base", "0.4 0.4 0.05", "0 0 -0.025"),
+            _link("f1", "0.02 0.02 0.1", "0 0 0.05"),
+            _link("f2", "0.02 0.02 0.1", "0 0 0.05"),
+            leader,
+            follower,
+        ]
+    )
+
+
+def test_mimic_follower_gets_the_range_its_mimic_maps_the_leader_to(tmp_path):
+    # PR2's l_gripper_r_parallel_root_joint: multiplier -1 on a 0..0.548 leader, limits
+    # 0..0.548, so any opening puts it out of its range
+    robot, _home, lines = _import(tmp_path, _gripper(-1.0, 0.0, 0.5))
+    joint = robot.joint("follow")
+    assert (joint.lower, joint.upper) == (-0.5, 0.0)
+    assert {"lower", "upper"} <= set(joint.estimated)
+    found = [line for line in lines if "do not hold the range of its mimic" in line]
+    assert len(found) == 1 and "-0.5..0" in found[0]
+
+
+def test_mimic_follower_whose_limits_hold_the_mapped_range_is_kept(tmp_path):
+    robot, _home, lines = _import(tmp_path, _gripper(1.0, 0.0, 0.6))
+    joint = robot.joint("follow")
+    assert (joint.lower, joint.upper) == (0.0, 0.6)
+    assert "lower" not in joint.estimated
+    assert not any("range of its mimic" in line for line in lines)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from simkit.importer.geometry import floats
-from simkit.importer.joints import joint_spec
+from simkit.importer.joints import joint_spec, mimic_limits
 from simkit.importer.links import has_geometry, has_mass, link_spec
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
@@ -226,8 +226,9 @@ def _estimated_solids(source: Source, links: list[dict], joints: list[dict], rep
 
 
 def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
-    """A mimic whose leader is not a movable joint of the spec is reported and dropped."""
-    movable = {j["name"] for j in joints if j["type"] not in ("fixed", "floating")}
+    """A mimic whose leader is not a movable joint of the spec is reported and dropped; a
+    follower whose limits contradict its mimic gets the leader's mapped range (joints.py)."""
+    movable = {j["name"]: j for j in joints if j["type"] not in ("fixed", "floating")}
     for joint in joints:
         mimic = joint.get("mimic")
         if mimic is not None and (mimic["joint"] not in movable or mimic["joint"] == joint["name"]):
@@ -239,6 +240,8 @@ def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
                 element if element is not None else source.root,
                 f"mimic of '{mimic['joint']}', not a movable joint: imported as independent",
             )
+        elif mimic is not None:
+            mimic_limits(source, joint, movable[mimic["joint"]], report)
 
 
 def _ancestors(tool: str | None, joints: list[dict], frames: list[dict]) -> set[str]:

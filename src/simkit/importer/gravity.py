@@ -34,6 +34,10 @@ GRID = 24  # range divisions tried per joint
 SWEEPS = 3  # moves per joint at most
 ROOM = 4  # the best moves that may also move a joint above them, when none is free alone
 GAIN = 0.005  # the least cost a move must save (no turns for a wrist roll's 0.1 %)
+#: m: how much deeper a pair of pieces overlapping at the start may go (the hull of a visual
+#: piece is coarse where it overlaps its neighbour already: Baxter's elbow hulls go 0.1 mm
+#: deeper as the elbow folds, while the kit's pieces, which follow the mesh, stay apart)
+SLACK = 0.001
 
 
 def _loads(robot, tree, q: np.ndarray) -> tuple[np.ndarray, list[int]]:
@@ -132,13 +136,15 @@ class _Search:
 
     def free(self, q: np.ndarray) -> bool:
         """No pair of geoms closer than the clearance, or than at the start where they were
-        closer already (the kit's collision pieces are not the search's)."""
+        closer already (the kit's collision pieces are not the search's), less `SLACK` for a
+        pair overlapping there."""
+        return all(self._allowed(pair, dist) for pair, dist in self._closest(q).items())
+
+    def _allowed(self, pair: tuple[int, int], dist: float) -> bool:
         from simkit.importer.home import CLEARANCE
 
-        return all(
-            dist >= min(CLEARANCE, self.near.get(pair, np.inf)) - 1e-6
-            for pair, dist in self._closest(q).items()
-        )
+        near = self.near.get(pair, np.inf)
+        return dist >= min(CLEARANCE, near) - (SLACK if near < 0.0 else 1e-6)
 
     def loads(self, q: np.ndarray) -> np.ndarray:
         return _loads(self.robot, self.tree, q)[0]

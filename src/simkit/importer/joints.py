@@ -160,3 +160,30 @@ def _num(text: str) -> float | None:
         return float(text)
     except ValueError:
         return None
+
+
+def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> None:
+    """A mimic follower whose limits do not hold its leader's range mapped through the mimic
+    (PR2's `l_gripper_r_parallel_root_joint`: multiplier -1 on a 0..0.548 leader, limits
+    0..0.548) gets that mapped range as its limits, marked estimated and reported: the
+    URDF's limits contradict its own mimic (any opening puts the follower out of range), and
+    the MJCF's equality would fight the follower's limit."""
+    keys = ("lower", "upper")
+    if any(k not in joint or k not in leader for k in keys):
+        return  # continuous (no limits): nothing to contradict
+    m = joint["mimic"]
+    lower, upper = sorted(m["multiplier"] * leader[k] + m["offset"] for k in keys)
+    tol = 1e-9 * max(1.0, abs(lower), abs(upper))
+    if lower >= joint["lower"] - tol and upper <= joint["upper"] + tol:
+        return
+    element = source.root.find(f"joint[@name='{joint['name']}']")
+    report.estimated(
+        source,
+        element if element is not None else source.root,
+        f"limits {joint['lower']:g}..{joint['upper']:g} do not hold the range of its mimic "
+        f"('{m['joint']}' {leader['lower']:g}..{leader['upper']:g} x {m['multiplier']:g} + "
+        f"{m['offset']:g}): {lower:g}..{upper:g}",
+    )
+    joint["lower"], joint["upper"] = lower, upper
+    done = joint.get("estimated", [])
+    joint["estimated"] = [*done, *(k for k in keys if k not in done)]
