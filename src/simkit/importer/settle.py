@@ -28,6 +28,7 @@ TIMESTEP = 0.002  # s, as the kit's MJCF
 TILT = 0.02  # rad: a settled base turned less than this stays level
 LIMIT = 0.8  # share of its effort a servo may need to hold the rest (kit page: 80 % rule)
 CANDIDATES = 48  # seeded random poses tried where home does not rest within LIMIT
+EDGE = 0.05  # share of a joint's range at each end no candidate is drawn from
 STILL = 0.01  # m/s or rad/s: the largest speed at the end of a settle that is at rest
 SERVO_STIFFNESS = 100.0  # N m/rad per N m of effort: the kit's servo (0.01 rad at the effort)
 
@@ -68,6 +69,20 @@ def _servos(robot) -> list:
     ]
 
 
+def _principal(tensor) -> dict[str, str]:
+    """MJCF `diaginertia` and `quat` of an inertia tensor (kg m^2, link axes): its principal
+    moments, none below a speck (an inertia_decision may keep one that is not positive
+    definite, HyQ's base)."""
+    from scipy.spatial.transform import Rotation
+
+    moments, axes = np.linalg.eigh(np.asarray(tensor, dtype=float))
+    if np.linalg.det(axes) < 0:
+        axes[:, 0] = -axes[:, 0]
+    moments = np.maximum(moments, 1e-12)  # the compiler balances a + b < c (balanceinertia)
+    x, y, z, w = Rotation.from_matrix(axes).as_quat()
+    return {"diaginertia": _text(moments), "quat": _text([w, x, y, z])}
+
+
 def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Element:
     """A body with the link's real inertial and its collision shapes (floor contact only)."""
     from simkit.importer.home import _geom
@@ -76,13 +91,12 @@ def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Elemen
     body = ET.SubElement(parent, "body", name=link.name, **attrs)
     inertial = link.inertial
     if inertial is not None and inertial.mass > 0:
-        ixx, iyy, izz, ixy, ixz, iyz = inertial.inertia
         ET.SubElement(
             body,
             "inertial",
             pos=_text(inertial.com),
             mass=repr(float(inertial.mass)),
-            fullinertia=_text([ixx, iyy, izz, ixy, ixz, iyz]),
+            **_principal(inertial.tensor()),
         )
     else:  # a massless link: a speck, so MuJoCo accepts a moving body
         ET.SubElement(body, "inertial", pos="0 0 0", mass="1e-6", diaginertia="1e-9 1e-9 1e-9")
@@ -99,7 +113,7 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
 
     floating = robot.floating_joint
     root = ET.Element("mujoco")
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    ET.SubElement(root, "compiler", angle="radian", autolimits="true", balanceinertia="true")
     ET.SubElement(root, "option", timestep=repr(TIMESTEP), integrator="implicitfast")
     ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
     asset = ET.SubElement(root, "asset")
@@ -227,6 +241,7 @@ class Settler:
         adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
         lo = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
         hi = np.array([j.upper if j.upper is not None else math.pi for j in movable])
+        lo, hi = lo + EDGE * (hi - lo), hi - EDGE * (hi - lo)  # a servo rests off its stops
         draws = lo + np.random.default_rng(0).random((CANDIDATES, len(movable))) * (hi - lo)
         free = [
             q
@@ -275,8 +290,10 @@ def rest_pose(spec_path: Path) -> tuple[list[float], Rest, str] | None:
     share, _, q, rest = best
     name = rest.worst[0]
     why = (
-        f"floating base at rest: settled {SECONDS:g} s on the floor (MuJoCo, the import's "
-        f"collision shapes, real masses, servos holding the pose), tilted {rest.tilt:.3g} rad "
-        f"onto its frame; largest static servo load {share:.0%} of effort ({name}), estimate"
+        f"floating base at rest: xyz {' '.join(f'{v:.4f}' for v in rest.xyz)} m, rpy "
+        f"{' '.join(f'{v:.4f}' for v in rest.rpy)} rad, where it settles in {SECONDS:g} s on "
+        f"the floor (MuJoCo, the import's collision shapes, real masses, servos holding the "
+        f"pose), tilted {rest.tilt:.3g} rad onto its frame; largest static servo load "
+        f"{share:.0%} of effort ({name}), estimate"
     )
     return [float(f"{v:.6g}") for v in q], rest, why
