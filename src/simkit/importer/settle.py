@@ -128,14 +128,27 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
         if joint.type == "floating" or joint.parent not in bodies:
             continue
         quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
-        body = _body(bodies[joint.parent], robot.link(joint.child), base_dir, asset,
-                     pos=_text(joint.xyz), quat=quat)
+        body = _body(
+            bodies[joint.parent],
+            robot.link(joint.child),
+            base_dir,
+            asset,
+            pos=_text(joint.xyz),
+            quat=quat,
+        )
         bodies[joint.child] = body
         kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
         if kind:
-            ET.SubElement(body, "joint", name=joint.name, type=kind, axis=_text(joint.axis),
-                          armature=repr(float(joint.armature)), damping=repr(float(joint.damping)),
-                          frictionloss=repr(float(joint.friction)))
+            ET.SubElement(
+                body,
+                "joint",
+                name=joint.name,
+                type=kind,
+                axis=_text(joint.axis),
+                armature=repr(float(joint.armature)),
+                damping=repr(float(joint.damping)),
+                frictionloss=repr(float(joint.friction)),
+            )
     contact = ET.SubElement(root, "contact")
     pairs = {(j.parent, j.child) for j in robot.joints if j.parent in bodies} | set(excluded)
     for a, b in sorted(pairs):
@@ -144,14 +157,25 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
     for joint in robot.movable_joints:
         if joint.mimic is not None and joint.mimic[0] in values:
             leader, multiplier, offset = joint.mimic
-            ET.SubElement(equality, "joint", joint1=joint.name, joint2=leader,
-                          polycoef=_text([offset, multiplier, 0, 0, 0]))
+            ET.SubElement(
+                equality,
+                "joint",
+                joint1=joint.name,
+                joint2=leader,
+                polycoef=_text([offset, multiplier, 0, 0, 0]),
+            )
     actuators = ET.SubElement(root, "actuator")
     for joint in _servos(robot):
         effort = float(joint.effort_peak)
-        ET.SubElement(actuators, "position", name=joint.name, joint=joint.name,
-                      kp=repr(SERVO_STIFFNESS * effort), dampratio="1",
-                      forcerange=_text([-effort, effort]))
+        ET.SubElement(
+            actuators,
+            "position",
+            name=joint.name,
+            joint=joint.name,
+            kp=repr(SERVO_STIFFNESS * effort),
+            dampratio="1",
+            forcerange=_text([-effort, effort]),
+        )
     return ET.tostring(root, encoding="unicode")
 
 
@@ -169,9 +193,7 @@ class Settler:
         home = np.asarray(home, dtype=float)
         self.robot, self.base_dir, self.follow = robot, base_dir, follow
         self.excluded = _always_touching(robot, base_dir, home, follow, _shapes)
-        self.model = mujoco.MjModel.from_xml_string(
-            model_xml(robot, base_dir, home, self.excluded)
-        )
+        self.model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, home, self.excluded))
         joint = lambda name: self.model.jnt_qposadr[self.model.joint(name).id]  # noqa: E731
         self.adr = np.array([joint(j.name) for j in robot.movable_joints], dtype=int)
         self.servos = _servos(robot)
