@@ -52,7 +52,39 @@ def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
     )
     text = writer.spec_yaml(spec, report.lines, path)
     spec_path.write_text(text, encoding="utf-8")
+    return _settle(spec, report, doc, spec_path, path) or text
+
+
+def _settle(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str | None:
+    """Start the free joint where the robot comes to rest at home when that is tilted onto
+    its frame (importer/settle.py: a flying arm leaning on its arm); the new spec text."""
+    from simkit.importer import settle, writer
+
+    found = settle.rest_pose(spec_path)
+    if found is None:
+        return None
+    pose, rest, why = found
+    if pose != spec["poses"]["home"]:
+        moved = ", ".join(
+            f"{j['name']}: {a:.4g} -> {b:.4g}"
+            for j, a, b in zip(_movable(spec), spec["poses"]["home"], pose, strict=True)
+            if a != b
+        )
+        why = f"home: the rest with the least servo load; {moved} rad or m; " + why
+        spec["poses"]["home"] = pose
+    joint = spec["joints"][0]
+    joint["xyz"] = [round(v, 4) + 0.0 for v in rest.xyz]
+    joint["rpy"] = [round(v, 4) + 0.0 for v in rest.rpy]
+    joint["estimated"] = sorted({*joint.get("estimated", []), "xyz", "rpy"})
+    report.assumed(doc, doc.root, why)
+    text = writer.spec_yaml(spec, report.lines, path)
+    spec_path.write_text(text, encoding="utf-8")
     return text
+
+
+def _movable(spec: dict) -> list[dict]:
+    """The spec's one-degree-of-freedom joints, in spec (pose) order."""
+    return [j for j in spec["joints"] if j["type"] not in ("fixed", "floating")]
 
 
 def _step_budget(spec: dict, stage: Path, report: Report, doc) -> None:

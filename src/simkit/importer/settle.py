@@ -1,0 +1,321 @@
+"""Where a floating robot that leans on a limb comes to rest: the free joint's pose at home.
+
+standing.py puts the base level with the lowest point of the geometry on the floor. A flying
+arm cannot rest that way: Hextilt's frame hull fills the space the arm could fold into, so
+its arm reaches below the frame and the robot, started level, tips onto two rim points and
+the arm (a 2.4 cm fall of the base, which the standing check counts as drift). This module
+lets the robot settle: a short MuJoCo run of the import's own collision geometry (the
+shapes stance.py collides, floor contact only: home is free of self-contact already) with
+the spec's real masses and inertias, each actuated joint held at home by a position servo
+as the kit's (kp = effort per 0.01 rad, force limited to the effort). Where the robot comes
+to rest tilted (more than `TILT`) with its frame (the base or a link welded to it) on the
+floor, and each servo holds its joint with at most `LIMIT` of its effort (the static torque
+the contact forces leave it), the settled pose becomes the free joint's origin, so the kit
+starts where the robot rests. Legged robots standing on their feet keep their level base.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+SECONDS = 2.0  # s of settling
+TIMESTEP = 0.002  # s, as the kit's MJCF
+TILT = 0.02  # rad: a settled base turned less than this stays level
+LIMIT = 0.8  # share of its effort a servo may need to hold the rest (kit page: 80 % rule)
+CANDIDATES = 48  # seeded random poses tried where home does not rest within LIMIT
+EDGE = 0.05  # share of a joint's range at each end no candidate is drawn from
+STILL = 0.01  # m/s or rad/s: the largest speed at the end of a settle that is at rest
+SERVO_STIFFNESS = 100.0  # N m/rad per N m of effort: the kit's servo (0.01 rad at the effort)
+
+
+@dataclass(frozen=True)
+class Rest:
+    """A settled pose: the free joint's origin (m, rad), each servo's static load as a share
+    of its effort (joint name -> share), whether the frame touches the floor, and whether
+    the robot came to rest."""
+
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+    loads: dict[str, float]
+    tilt: float
+    frame_down: bool
+    still: bool
+
+    @property
+    def worst(self) -> tuple[str, float]:
+        """The servo holding the largest share of its effort (name, share)."""
+        return max(self.loads.items(), key=lambda kv: (kv[1], kv[0]), default=("", 0.0))
+
+    def holds(self) -> bool:
+        """Resting, frame down, tilted, every servo within LIMIT: worth starting from."""
+        return self.still and self.frame_down and self.tilt > TILT and self.worst[1] <= LIMIT
+
+
+def _text(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+def _servos(robot) -> list:
+    """Joints the kit drives: movable, actuated, no mimic, with an effort."""
+    return [
+        j
+        for j in robot.movable_joints
+        if j.actuated and j.mimic is None and j.effort_peak and j.effort_peak > 0
+    ]
+
+
+def _principal(tensor) -> dict[str, str]:
+    """MJCF `diaginertia` and `quat` of an inertia tensor (kg m^2, link axes): its principal
+    moments, none below a speck (an inertia_decision may keep one that is not positive
+    definite, HyQ's base)."""
+    from scipy.spatial.transform import Rotation
+
+    moments, axes = np.linalg.eigh(np.asarray(tensor, dtype=float))
+    if np.linalg.det(axes) < 0:
+        axes[:, 0] = -axes[:, 0]
+    moments = np.maximum(moments, 1e-12)  # the compiler balances a + b < c (balanceinertia)
+    x, y, z, w = Rotation.from_matrix(axes).as_quat()
+    return {"diaginertia": _text(moments), "quat": _text([w, x, y, z])}
+
+
+def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Element:
+    """A body with the link's real inertial and its collision shapes (floor contact only)."""
+    from simkit.importer.home import _geom
+    from simkit.importer.stance import _shapes
+
+    body = ET.SubElement(parent, "body", name=link.name, **attrs)
+    inertial = link.inertial
+    if inertial is not None and inertial.mass > 0:
+        ET.SubElement(
+            body,
+            "inertial",
+            pos=_text(inertial.com),
+            mass=repr(float(inertial.mass)),
+            **_principal(inertial.tensor()),
+        )
+    else:  # a massless link: a speck, so MuJoCo accepts a moving body
+        ET.SubElement(body, "inertial", pos="0 0 0", mass="1e-6", diaginertia="1e-9 1e-9 1e-9")
+    for i, shape in enumerate(_shapes(link)):
+        _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+    return body
+
+
+def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
+    """The settle model: floor, free base at the floating joint's origin, servos at `home`;
+    links collide with the floor and each other but for joined links and `excluded` pairs
+    (those touching wherever the joints are, which the kit excludes)."""
+    from simkit.model.kinematics import quat_wxyz, rpy_matrix
+
+    floating = robot.floating_joint
+    root = ET.Element("mujoco")
+    ET.SubElement(root, "compiler", angle="radian", autolimits="true", balanceinertia="true")
+    ET.SubElement(root, "option", timestep=repr(TIMESTEP), integrator="implicitfast")
+    ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
+    asset = ET.SubElement(root, "asset")
+    world = ET.SubElement(root, "worldbody")
+    ET.SubElement(world, "geom", name="floor", type="plane", size="0 0 0.05")
+    base = robot.link(floating.child)
+    quat = _text(quat_wxyz(rpy_matrix(floating.rpy)))
+    bodies = {base.name: _body(world, base, base_dir, asset, pos=_text(floating.xyz), quat=quat)}
+    ET.SubElement(bodies[base.name], "freejoint", name=floating.name)
+    values = {j.name: q for j, q in zip(robot.movable_joints, home, strict=True)}
+    for joint in robot.joints:
+        if joint.type == "floating" or joint.parent not in bodies:
+            continue
+        quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
+        body = _body(
+            bodies[joint.parent],
+            robot.link(joint.child),
+            base_dir,
+            asset,
+            pos=_text(joint.xyz),
+            quat=quat,
+        )
+        bodies[joint.child] = body
+        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
+        if kind:
+            ET.SubElement(
+                body,
+                "joint",
+                name=joint.name,
+                type=kind,
+                axis=_text(joint.axis),
+                armature=repr(float(joint.armature)),
+                damping=repr(float(joint.damping)),
+                frictionloss=repr(float(joint.friction)),
+            )
+    contact = ET.SubElement(root, "contact")
+    pairs = {(j.parent, j.child) for j in robot.joints if j.parent in bodies} | set(excluded)
+    for a, b in sorted(pairs):
+        ET.SubElement(contact, "exclude", body1=a, body2=b)
+    equality = ET.SubElement(root, "equality")
+    for joint in robot.movable_joints:
+        if joint.mimic is not None and joint.mimic[0] in values:
+            leader, multiplier, offset = joint.mimic
+            ET.SubElement(
+                equality,
+                "joint",
+                joint1=joint.name,
+                joint2=leader,
+                polycoef=_text([offset, multiplier, 0, 0, 0]),
+            )
+    actuators = ET.SubElement(root, "actuator")
+    for joint in _servos(robot):
+        effort = float(joint.effort_peak)
+        ET.SubElement(
+            actuators,
+            "position",
+            name=joint.name,
+            joint=joint.name,
+            kp=repr(SERVO_STIFFNESS * effort),
+            dampratio="1",
+            forcerange=_text([-effort, effort]),
+        )
+    return ET.tostring(root, encoding="unicode")
+
+
+class Settler:
+    """The settle model of one robot (its always-touching pairs found at `home`), run from
+    any pose: the base level at the floating joint's rotation, its lowest point on the floor
+    (standing.py's measure)."""
+
+    def __init__(self, robot, base_dir: Path, home, follow):
+        import mujoco
+
+        from simkit.importer.home import _always_touching
+        from simkit.importer.stance import _shapes, _Support
+
+        home = np.asarray(home, dtype=float)
+        self.robot, self.base_dir, self.follow = robot, base_dir, follow
+        self.excluded = _always_touching(robot, base_dir, home, follow, _shapes)
+        self.model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, home, self.excluded))
+        joint = lambda name: self.model.jnt_qposadr[self.model.joint(name).id]  # noqa: E731
+        self.adr = np.array([joint(j.name) for j in robot.movable_joints], dtype=int)
+        self.servos = _servos(robot)
+        self.servo_adr = np.array([joint(j.name) for j in self.servos], dtype=int)
+        self.frame = _Support(robot, base_dir).frame
+        self.free = self.model.jnt_qposadr[self.model.joint(robot.floating_joint.name).id]
+
+    def height(self, q) -> float:
+        """m the base's origin stands above the floor at `q`, the base at its rotation."""
+        from simkit.importer.standing import _lowest, floor_shapes
+        from simkit.model.kinematics import forward
+
+        poses = forward(self.robot, list(q))
+        base = poses[self.robot.floating_joint.child][2, 3]
+        low = [
+            _lowest(shape, poses[link.name], self.base_dir)
+            for link in self.robot.links
+            for shape in floor_shapes(link)
+        ]
+        return float(base - min(low)) if low else 0.0
+
+    def run(self, q) -> Rest:
+        """Settle from `q` (spec order) for SECONDS; the pose it comes to rest in."""
+        import mujoco
+
+        model, data = self.model, mujoco.MjData(self.model)
+        data.qpos[self.free + 2] = self.height(q)
+        data.qpos[self.adr] = q
+        data.ctrl[:] = data.qpos[self.servo_adr]
+        start = data.qpos[self.free + 3 : self.free + 7].copy()
+        for _ in range(round(SECONDS / TIMESTEP)):
+            mujoco.mj_step(model, data)
+        if not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))):
+            return Rest((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), {}, 0.0, False, False)
+        floor = model.geom("floor").id
+        down = any(
+            floor in (c.geom1, c.geom2)
+            and model.body(model.geom_bodyid[c.geom1 + c.geom2 - floor]).name in self.frame
+            for c in data.contact[: data.ncon]
+        )
+        loads = {
+            j.name: abs(float(data.actuator_force[a])) / float(j.effort_peak)
+            for a, j in enumerate(self.servos)
+        }
+        quat = data.qpos[self.free + 3 : self.free + 7]
+        tilt = 2.0 * math.acos(min(1.0, abs(float(np.dot(quat, start)))))
+        return Rest(
+            tuple(float(v) for v in data.qpos[self.free : self.free + 3]),
+            _rpy(quat),
+            loads,
+            tilt,
+            down,
+            float(np.abs(data.qvel).max()) < STILL,
+        )
+
+    def candidates(self, home) -> np.ndarray:
+        """`home`, then CANDIDATES seeded random poses free of self-contact (stance.py's
+        model, the always-touching pairs left out), nearest home first."""
+        import mujoco
+
+        from simkit.importer import stance
+
+        robot = self.robot
+        movable = robot.movable_joints
+        model = mujoco.MjModel.from_xml_string(stance._model_xml(robot, self.base_dir))
+        data = mujoco.MjData(model)
+        adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+        lo = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
+        hi = np.array([j.upper if j.upper is not None else math.pi for j in movable])
+        lo, hi = lo + EDGE * (hi - lo), hi - EDGE * (hi - lo)  # a servo rests off its stops
+        draws = lo + np.random.default_rng(0).random((CANDIDATES, len(movable))) * (hi - lo)
+        free = [
+            q
+            for q in (self.follow(d) for d in draws)
+            if all(
+                p in self.excluded or depth <= stance.TOUCH
+                for p, depth in stance._contacts(model, data, adr, q).items()
+            )
+        ]
+        home = np.asarray(home, dtype=float)
+        free.sort(key=lambda q: float(np.linalg.norm(q - home)))
+        return np.array([home, *free])
+
+
+def _rpy(quat) -> tuple[float, float, float]:
+    """URDF roll, pitch, yaw (rad, fixed axes x, y, z) of a unit quaternion (w, x, y, z)."""
+    from scipy.spatial.transform import Rotation
+
+    w, x, y, z = (float(v) for v in quat)
+    return tuple(float(v) for v in Rotation.from_quat([x, y, z, w]).as_euler("xyz"))
+
+
+def rest_pose(spec_path: Path) -> tuple[list[float], Rest, str] | None:
+    """Where a robot that tips onto its frame at home comes to rest: home where its servos
+    hold that rest within LIMIT, else the seeded candidate pose (Settler.candidates) whose
+    rest needs the least of any servo's effort; the pose, its rest and one report line.
+    None where the robot stands level at home (legs), or no candidate rests within LIMIT."""
+    from simkit.importer.home import load
+
+    robot, home, follow = load(spec_path)
+    if robot.floating_joint is None or home is None or not _servos(robot):
+        return None
+    settler = Settler(robot, spec_path.parent, home, follow)
+    first = settler.run(home)
+    if first.tilt <= TILT or not first.frame_down:  # level on its feet: standing.py's stance
+        return None
+    best: tuple[float, int, np.ndarray, Rest] | None = None
+    for n, q in enumerate(settler.candidates(home)):
+        rest = first if n == 0 else settler.run(q)
+        if rest.holds() and (best is None or rest.worst[1] < best[0] - 1e-9):
+            best = (rest.worst[1], n, q, rest)
+        if best is not None and n == 0:  # home holds: keep it
+            break
+    if best is None:
+        return None
+    share, _, q, rest = best
+    name = rest.worst[0]
+    why = (
+        f"floating base at rest: xyz {' '.join(f'{v:.4f}' for v in rest.xyz)} m, rpy "
+        f"{' '.join(f'{v:.4f}' for v in rest.rpy)} rad, where it settles in {SECONDS:g} s on "
+        f"the floor (MuJoCo, the import's collision shapes, real masses, servos holding the "
+        f"pose), tilted {rest.tilt:.3g} rad onto its frame; largest static servo load "
+        f"{share:.0%} of effort ({name}), estimate"
+    )
+    return [float(f"{v:.6g}") for v in q], rest, why
