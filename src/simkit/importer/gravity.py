@@ -15,7 +15,7 @@ joints over `AIM` and every non-mimic joint they carry move one at a time to the
 that lowers the summed excess over `AIM` most (the arm hangs, or folds), nearest the current
 value on a tie, never at a limit, never bringing two links closer than the clearance (or
 than at home, where they are closer there) on home.py's model with the visual pieces the
-kit's collision covers (limits.py). Where no such move is free, one other joint, above
+kit's collision covers (home.covered_shapes). Where no such move is free, one other joint, above
 them or below, may move too (PR2's torso rises so a lowered arm clears the base). Effort
 numbers are never changed.
 """
@@ -108,12 +108,12 @@ class _Search:
         self.spec_dir = spec_path.parent
 
     def open(self) -> None:
-        """The collision model (home.py's, with the visual pieces, limits.py) and the
+        """The collision model (home.py's, with the visual pieces: home.covered_shapes) and the
         closest distance (m) of each pair of links near each other at the start."""
-        from simkit.importer import home, limits
+        from simkit.importer import home
 
         always = home._always_touching(self.robot, self.spec_dir, self.start, self.follow)
-        xml = home._model_xml(self.robot, self.spec_dir, always, shapes_of=limits._shapes)
+        xml = home._model_xml(self.robot, self.spec_dir, always, shapes_of=home.covered_shapes)
         self.model = self.mujoco.MjModel.from_xml_string(xml)
         self.data = self.mujoco.MjData(self.model)
         self.adr = np.array(

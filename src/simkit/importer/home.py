@@ -65,6 +65,13 @@ def _shapes(link) -> tuple:
     return link.shapes
 
 
+def covered_shapes(link) -> tuple:
+    """Collision shapes and, for a link that has some, its visual pieces too: the kit grows
+    its collision pieces to cover the visual (a link without collision has none in the kit)."""
+    given = tuple(_shapes(link))
+    return given + tuple(s for s in link.shapes if s not in given) if given else ()
+
+
 def _adjacent(robot) -> set[tuple[str, str]]:
     """Links joined by a joint, or through links without geometry (the kit's exclusions)."""
     near: dict[str, set[str]] = {}
@@ -249,16 +256,15 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     or None when the spec's home is already free or the search finds no free pose. Only the
     joints between two links in contact move, each to the grid value that leaves the least
     penetration, the one nearest the first guess on a tie. A second search, from the first
-    one's pose, adds the links' visual pieces (limits.py), which the kit's collision pieces
+    one's pose, adds the links' visual pieces (covered_shapes), which the kit's collision pieces
     are grown to cover (Alex's Sake fingers, whose collision meshes sit apart from their
     visual ones, touch only there)."""
-    from simkit.importer import limits
 
     robot, start, follow = load(spec_path)
     if start is None:  # no movable joint: nothing to move
         return None
     q = start
-    for shapes_of in (_shapes, limits._shapes):
+    for shapes_of in (_shapes, covered_shapes):
         q = _search(robot, spec_path.parent, q, follow, shapes_of)
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"

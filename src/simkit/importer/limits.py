@@ -25,15 +25,6 @@ BACK_OFF = 2  # steps kept clear of the first contact (the check sweeps in 2 deg
 DIGITS = 4  # decimals of a narrowed limit, rounded towards home
 
 
-def _shapes(link) -> tuple:
-    """Collision shapes and, for a link that has some, its visual pieces too: the kit grows
-    its collision pieces to cover the visual (a link without collision has none in the kit)."""
-    from simkit.importer.home import _shapes as collision
-
-    given = tuple(collision(link))
-    return given + tuple(s for s in link.shapes if s not in given) if given else ()
-
-
 def narrowed(spec_path: Path) -> dict[str, tuple[float, float]]:
     """{joint: (lower, upper)} for each joint whose estimated limits were narrowed (rad or
     m), none when home itself is in contact (nothing to measure a free range from)."""
@@ -46,7 +37,7 @@ def narrowed(spec_path: Path) -> dict[str, tuple[float, float]]:
         return {}
     always = home._always_touching(robot, spec_path.parent, start, follow)
     model = mujoco.MjModel.from_xml_string(
-        home._model_xml(robot, spec_path.parent, always, shapes_of=_shapes)
+        home._model_xml(robot, spec_path.parent, always, shapes_of=home.covered_shapes)
     )
     data = mujoco.MjData(model)
     movable = robot.movable_joints

@@ -15,6 +15,19 @@ from pathlib import Path
 
 import numpy as np
 
+#: COLLADA Y_UP to a Z-up frame: file (x, y, z) -> (x, -z, y)
+Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+
+
+def is_y_up(path: Path) -> bool:
+    """A COLLADA file whose `<asset>` says `<up_axis>Y_UP</up_axis>` (up_axis.py decides
+    whether a URDF's such meshes are turned)."""
+    if path.suffix.lower() != ".dae" or not path.is_file():
+        return False
+    head = path.read_bytes()[:65536].decode("utf-8", "replace")
+    return re.search(r"<up_axis>\s*Y_UP\s*</up_axis>", head) is not None
+
+
 MESH_DIR = "meshes"
 SUPPORTED = (".stl", ".obj", ".dae")
 
@@ -123,13 +136,10 @@ class MeshWriter:
             mesh = _load(path)
         except Exception as exc:  # trimesh raises many types on bad files
             raise ValueError(f"cannot read mesh: {' '.join(str(exc).split())}") from None
-        if self.turn_y_up:
-            from simkit.importer.up_axis import Y_UP_TO_Z_UP, is_y_up
-
-            if is_y_up(path):
-                turn = np.eye(4)
-                turn[:3, :3] = Y_UP_TO_Z_UP
-                mesh.apply_transform(turn)
+        if self.turn_y_up and is_y_up(path):
+            turn = np.eye(4)
+            turn[:3, :3] = Y_UP_TO_Z_UP
+            mesh.apply_transform(turn)
         mesh.apply_scale(np.asarray(scale, float))
         vertices, faces, repair = closed_solid(mesh)
         solid = trimesh.Trimesh(vertices, faces, process=False)

@@ -12,22 +12,13 @@ link's mesh bounds and brings the mesh centroids nearer the inertial CoMs. Repor
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
 
-#: COLLADA Y_UP to a Z-up frame: file (x, y, z) -> (x, -z, y)
-Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+from simkit.importer.meshes import Y_UP_TO_Z_UP, is_y_up
+
 SLACK = 0.01  # m a child joint origin may lie outside its link's mesh bounds
-
-
-def is_y_up(path: Path) -> bool:
-    """A COLLADA file whose `<asset>` says `<up_axis>Y_UP</up_axis>`."""
-    if path.suffix.lower() != ".dae" or not path.is_file():
-        return False
-    head = path.read_bytes()[:65536].decode("utf-8", "replace")
-    return re.search(r"<up_axis>\s*Y_UP\s*</up_axis>", head) is not None
 
 
 def _vertices(path: Path, scale) -> np.ndarray | None:
