@@ -13,6 +13,7 @@ import argparse
 import json
 import re
 import resource
+import shutil
 import site
 import subprocess
 import sys
@@ -93,6 +94,7 @@ def one(urdf: Path, root: Path, work: Path, timeout: float, hull: bool) -> dict:
     cache = work / "cache" / name
     kits = work / "kits"
     build = ["build", str(spec), "--out", str(kits), "-q", "--cache-dir", str(cache)]
+    shutil.rmtree(cache, ignore_errors=True)  # cold means cold: no entries from earlier runs
     rc, text, row["cold"] = _run(build, timeout)
     if rc:
         row["build"] = "fail"
