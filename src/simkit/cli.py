@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 from rich.console import Console
 
 from simkit import __version__
 from simkit.errors import SimkitError
+
+if TYPE_CHECKING:
+    from simkit.kitio.cache import Cache
 
 err = Console(stderr=True, highlight=False, soft_wrap=True)
 out = Console(highlight=False, soft_wrap=True)
@@ -47,11 +51,23 @@ def main() -> None:
 )
 @click.option(
     "--cache-dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=click.Path(file_okay=False),  # kept as typed: a URL here is refused (cache.py)
     default=None,
     help="Cache folder. [default: $SIMKIT_CACHE_DIR, else the user cache folder]",
 )
 @click.option("--no-cache", is_flag=True, help="Compute every step; read and write no cache.")
+@click.option(
+    "--cache-readonly",
+    is_flag=True,
+    envvar="SIMKIT_CACHE_READONLY",
+    help="Read the caches, never write them (untrusted runners, e.g. fork pull requests).",
+)
+@click.option(
+    "--remote-cache",
+    default=None,
+    envvar="SIMKIT_REMOTE_CACHE",
+    help="Shared cache behind the local one, an fsspec URL such as s3://bucket/prefix.",
+)
 @click.option(
     "--usd-format",
     type=click.Choice(["usda", "usdc"]),
@@ -70,18 +86,21 @@ def build(
     no_check: bool,
     quiet: bool,
     jobs: int | None,
-    cache_dir: Path | None,
+    cache_dir: str | None,
     no_cache: bool,
+    cache_readonly: bool,
+    remote_cache: str | None,
     usd_format: str,
     no_step: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
-    from simkit.kitio.cache import Cache
+    from simkit.kitio.cache import Stats
     from simkit.pipeline import build as run_build
 
-    cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
+    cache = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
 
     for target in targets:
+        cache.stats = Stats()  # each summary line counts its own robot's hits
 
         def progress(msg: str, _t: str = target) -> None:
             if not quiet:
@@ -101,11 +120,24 @@ def build(
         except SimkitError as exc:
             _fail(exc)
         passed = sum(f.ok for f in result.findings)
+        hits = f"; cache local/remote/miss: {cache.stats.summary()}" if cache.enabled else ""
         out.print(
             f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed",
+            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed{hits}",
             markup=False,
         )
+
+
+def _open_cache(dir_: str | None, off: bool, readonly: bool, remote: str | None) -> Cache:
+    """The build's cache from the command line (a URL as --cache-dir: one-line error)."""
+    from simkit.kitio.cache import Cache
+
+    if off:
+        return Cache.disabled()
+    try:
+        return Cache.at(dir_, readonly=readonly, remote=remote)
+    except SimkitError as exc:
+        _fail(exc)
 
 
 @main.command()
@@ -227,17 +259,29 @@ def view(kit: Path, port: int, no_browser: bool) -> None:
     help="The site's /assets/sim/ folder (replaced as a whole).",
 )
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
-def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
+@click.option("--cache-dir", type=click.Path(file_okay=False), default=None, help="As build's.")
+@click.option("--cache-readonly", is_flag=True, envvar="SIMKIT_CACHE_READONLY", help="As build's.")
+@click.option("--remote-cache", default=None, envvar="SIMKIT_REMOTE_CACHE", help="As build's.")
+def publish(
+    robots: tuple[str, ...],
+    out_dir: Path,
+    quiet: bool,
+    cache_dir: str | None,
+    cache_readonly: bool,
+    remote_cache: str | None,
+) -> None:
     """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and
     index.json, as the download site serves them under /assets/sim/."""
     from simkit.publish import publish as run_publish
+
+    cache = _open_cache(cache_dir, False, cache_readonly, remote_cache)
 
     def progress(msg: str) -> None:
         if not quiet:
             err.print(msg, markup=False)
 
     try:
-        index = run_publish(out_dir, robots or None, progress=progress)
+        index = run_publish(out_dir, robots or None, progress=progress, cache=cache)
     except SimkitError as exc:
         _fail(exc)
     files = sum(len(kit["files"]) for kit in index["kits"])

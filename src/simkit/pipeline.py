@@ -18,7 +18,7 @@ from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.errors import CheckFailed, SpecError, UnknownRobot
-from simkit.kitio import atomic, forked, layout
+from simkit.kitio import atomic, confine, forked, layout
 from simkit.kitio.archive import zip_bytes
 from simkit.kitio.cache import (
     Arrays,
@@ -122,8 +122,11 @@ def _pack_files(files: dict[str, bytes]) -> Arrays:
 
 
 def _unpack_files(stored: Arrays) -> dict[str, bytes]:
+    """The files of an entry; a stored path that would leave the kit raises (a miss)."""
     blob = stored["blob"].tobytes()
-    return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
+    files = {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
+    confine.check_tree(files)
+    return files
 
 
 def _template_bytes() -> list[bytes]:
@@ -194,11 +197,8 @@ def _zip_cached(files: dict[str, bytes], top: str, cache: Cache) -> bytes:
 
 
 def write_tree(root: Path, files: dict[str, bytes]) -> None:
-    """Write `files` (POSIX relative paths) under `root`."""
-    for rel, data in files.items():
-        target = root.joinpath(*rel.split("/"))
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(data)
+    """Write `files` (POSIX relative paths) under `root`, each confined to it."""
+    confine.write_tree(root, files)
 
 
 def build(
