@@ -55,7 +55,7 @@ def _filesystem(url: str) -> tuple[object, str]:
             "config_kwargs": {
                 "connect_timeout": CONNECT_TIMEOUT_S,
                 "read_timeout": READ_TIMEOUT_S,
-                "retries": {"max_attempts": 2, "mode": "standard"},
+                "retries": {"max_attempts": 1, "mode": "standard"},
             },
         }
     try:
