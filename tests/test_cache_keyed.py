@@ -154,14 +154,36 @@ def test_a_full_disk_leaves_no_truncated_entry(tmp_path):
     assert [p for p in (tmp_path / "c").rglob("*") if p.is_file()] == []
 
 
-def test_cache_dir_given_a_url_is_one_line_pointing_to_remote_cache(tmp_path):
-    cmd = [sys.executable, "-m", "simkit.cli", "build", str(SPEC), "--out", str(tmp_path / "o")]
+@pytest.mark.parametrize("command", ["build", "publish"])
+def test_cache_dir_given_a_url_is_one_line_pointing_to_remote_cache(tmp_path, command):
+    target = [str(SPEC)] if command == "build" else []
+    cmd = [sys.executable, "-m", "simkit.cli", command, *target, "--out", str(tmp_path / "o")]
     proc = subprocess.run(
         [*cmd, "--cache-dir", "s3://bucket/prefix"], capture_output=True, text=True, cwd=tmp_path
     )
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "--remote-cache" in proc.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # no folder named 's3:'
+
+
+def test_a_full_disk_while_staging_files_is_one_line_naming_the_file(tmp_path):
+    script = (
+        "import resource, signal, sys\n"
+        "from pathlib import Path\n"
+        "from simkit.errors import SimkitError\n"
+        "from simkit.kitio.confine import write_tree\n"
+        "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (65536, 65536))\n"
+        "try:\n"
+        f"    write_tree(Path({str(tmp_path / 'kit')!r}), {{'a/big.bin': bytes(100000)}})\n"
+        "except SimkitError as exc:\n"
+        "    print(exc)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert (
+        proc.stdout.strip() == f"{tmp_path / 'kit' / 'a' / 'big.bin'}: cannot write: File too large"
+    )
 
 
 def _scale_solids(cache_dir: Path) -> None:

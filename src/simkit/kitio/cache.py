@@ -250,8 +250,8 @@ class Cache:
             return decode_entry(data, step, key, self.secret)
         except Unauthenticated:
             self._warn(
-                f"a '{step}' cache entry has no valid {ENV_SECRET} tag; recomputed "
-                "(entries written without the key, or forged, are not trusted)",
+                f"cache entries without a valid {ENV_SECRET} tag (written without the key, "
+                f"or forged) are recomputed; the first was a '{step}' entry",
                 "<tag>",
             )
             raise

@@ -70,4 +70,6 @@ def write_tree(root: Path, files: Mapping[str, bytes]) -> None:
             with os.fdopen(fd, "wb") as handle:
                 handle.write(data)
         except OSError as exc:
+            if target.is_file() and not target.is_symlink():
+                target.unlink()  # no truncated file left behind
             raise SimkitError(f"{target}: cannot write: {exc.strerror}") from None
