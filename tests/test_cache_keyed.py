@@ -252,3 +252,11 @@ def test_a_forged_emit_entry_with_a_climbing_path_writes_nothing_outside_out(tmp
     build(str(SPEC), out, cache=cache, jobs=1)
     assert not list(tmp_path.rglob("escape.txt"))
     assert _kit_zip(out) == cold and cache.stats.repaired == {"emit": 1, "simulate": 1}
+
+
+def test_cache_dir_env_given_a_url_is_refused(monkeypatch):
+    from simkit.errors import SimkitError
+
+    monkeypatch.setenv("SIMKIT_CACHE_DIR", "s3://bucket/prefix")
+    with pytest.raises(SimkitError, match=r"^\$SIMKIT_CACHE_DIR s3://bucket/prefix: is a URL"):
+        Cache.at()

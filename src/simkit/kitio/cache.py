@@ -180,9 +180,10 @@ class Cache:
         """The cache at `root` (default: env, then user cache folder). `readonly` and
         `remote` default to `$SIMKIT_CACHE_READONLY` and `$SIMKIT_REMOTE_CACHE`; the
         secret is always `$SIMKIT_CACHE_KEY`. A URL as `root` is a one-line error."""
-        if root is not None and is_url(str(root)):
+        given = ("--cache-dir", str(root)) if root else (f"${ENV_DIR}", os.environ.get(ENV_DIR))
+        if given[1] and is_url(given[1]):
             raise SimkitError(
-                f"--cache-dir {root}: is a URL; the cache folder is local, give the URL "
+                f"{given[0]} {given[1]}: is a URL; the cache folder is local, give the URL "
                 "to --remote-cache (or $SIMKIT_REMOTE_CACHE)"
             )
         cache = Cache(
@@ -265,9 +266,7 @@ class Cache:
             return None
         try:
             arrays = self._verified(data, step, key)
-        except OldFormat:
-            return None
-        except (BadEntry, Unauthenticated) as exc:
+        except (BadEntry, OldFormat, Unauthenticated) as exc:
             self.bad_remote.add((step, key))
             if isinstance(exc, BadEntry):
                 self._warn(
