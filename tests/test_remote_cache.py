@@ -313,3 +313,16 @@ def test_unreachable_store_gives_one_warning_and_a_correct_kit(runner_a, tmp_pat
     counts, kit, err, _ = _runner(tmp_path, "e", dead, "--remote-cache", "s3://fleet/cache")
     assert kit == runner_a[1] and len(_warnings(err)) == 1 and "unreachable" in err
     assert all(remote == 0 for _, remote, _ in counts.values())
+
+
+def test_without_a_remote_url_fsspec_is_not_imported(tmp_path):
+    script = (
+        "import sys\n"
+        "from simkit.kitio.cache import Cache, make_key\n"
+        f"c = Cache.at({str(tmp_path)!r}, remote='')\n"
+        "c.put('s', make_key('s', 1, [], {}), {})\n"
+        "print(sorted(m for m in ('fsspec', 's3fs', 'botocore') if m in sys.modules))\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in SIMKIT_ENV}
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env)
+    assert proc.returncode == 0 and proc.stdout.strip() == "[]", proc.stderr
