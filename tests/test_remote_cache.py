@@ -105,6 +105,16 @@ def test_temporary_key_and_copy_is_write_once(s3):
     assert list(_objects(s3).values()) == [b"verified"]
 
 
+def test_any_fsspec_store_serves_as_the_remote(tmp_path):
+    """S3 is the tested store; the same code writes once to another fsspec store."""
+    url = f"file://{tmp_path / 'shared'}"
+    Cache.at(tmp_path / "a", readonly=False, remote=url).put("s", KEY, {"v": np.arange(3.0)})
+    Cache.at(tmp_path / "x", readonly=False, remote=url).put("s", KEY, {"v": np.arange(9.0)})
+    b = Cache.at(tmp_path / "b", readonly=False, remote=url)
+    np.testing.assert_array_equal(b.get("s", KEY)["v"], np.arange(3.0))
+    assert b.stats.remote == {"s": 1}
+
+
 def test_local_cache_stays_in_front_of_the_remote(s3, tmp_path):
     Cache.at(tmp_path / "a", readonly=False, remote=s3).put("s", KEY, {"v": np.arange(3.0)})
     b = Cache.at(tmp_path / "b", readonly=False, remote=s3)

@@ -350,11 +350,13 @@ class Cache:
             with os.fdopen(fd, "wb") as handle:
                 handle.write(data)
             os.replace(tmp, path)
+            tmp = None
         except OSError as exc:
-            if tmp is not None:
-                Path(tmp).unlink(missing_ok=True)
             why = f"cache folder {self.root} is not writable ({exc.strerror}); results not cached"
             self._warn(why, "<write>")
+        finally:  # on every way out, an interrupt included: no temp file left
+            if tmp is not None:
+                Path(tmp).unlink(missing_ok=True)
 
     def memo(self, step: str, key: str, compute: Callable[[], Arrays]) -> Arrays:
         """`get`, else `compute` and `put`."""

@@ -58,6 +58,8 @@ def _filesystem(url: str) -> tuple[object, str]:
                 "retries": {"max_attempts": 1, "mode": "standard"},
             },
         }
+    if protocol in ("file", "local"):
+        options = {"auto_mkdir": True}  # a shared folder: create STEP/KK/ as needed
     try:
         fs, root = fsspec.core.url_to_fs(url, **options)
     except ImportError as exc:
