@@ -13,6 +13,7 @@ from simkit.errors import SimkitError
 
 err = Console(stderr=True, highlight=False, soft_wrap=True)
 out = Console(highlight=False, soft_wrap=True)
+RAY_HELP = "One Ray task per robot ($RAY_ADDRESS, else a local Ray); needs simkit[ray]."
 
 
 def _fail(exc: SimkitError) -> None:
@@ -64,6 +65,7 @@ def main() -> None:
     is_flag=True,
     help="Leave out step/NAME.step (the STEP assembly; saves the Open CASCADE time).",
 )
+@click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
 def build(
     targets: tuple[str, ...],
     out_dir: Path,
@@ -74,12 +76,19 @@ def build(
     no_cache: bool,
     usd_format: str,
     no_step: bool,
+    on_ray: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
     from simkit.kitio.cache import Cache
     from simkit.pipeline import build as run_build
 
     cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
+    if on_ray:
+        options = {"check": not no_check, "usd_format": usd_format, "step": not no_step}
+        if no_cache or cache_dir is not None:  # else each worker's own default cache
+            options["cache"] = cache
+        _build_on_ray(targets, out_dir, quiet, options)
+        return
 
     for target in targets:
 
@@ -100,12 +109,28 @@ def build(
             )
         except SimkitError as exc:
             _fail(exc)
-        passed = sum(f.ok for f in result.findings)
-        out.print(
-            f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed",
-            markup=False,
-        )
+        out.print(_built_line(result), markup=False)
+
+
+def _built_line(result) -> str:
+    passed = sum(f.ok for f in result.findings)
+    return (
+        f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
+        f"{result.zip_path}; {passed}/{len(result.findings)} checks passed"
+    )
+
+
+def _build_on_ray(targets: tuple[str, ...], out_dir: Path, quiet: bool, options: dict) -> None:
+    """`simkit build --ray`: one Ray task per target, published here (simkit/cluster.py)."""
+    from simkit.cluster import build_on_ray
+
+    try:
+        results = build_on_ray(targets, out_dir, None if quiet else _say, **options)
+    except SimkitError as exc:
+        _fail(exc)
+        return
+    for result in results:
+        out.print(_built_line(result), markup=False)
 
 
 @main.command()
@@ -227,7 +252,8 @@ def view(kit: Path, port: int, no_browser: bool) -> None:
     help="The site's /assets/sim/ folder (replaced as a whole).",
 )
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
-def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
+@click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
+def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool, on_ray: bool) -> None:
     """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and
     index.json, as the download site serves them under /assets/sim/."""
     from simkit.publish import publish as run_publish
@@ -237,7 +263,7 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
             err.print(msg, markup=False)
 
     try:
-        index = run_publish(out_dir, robots or None, progress=progress)
+        index = run_publish(out_dir, robots or None, progress=progress, on_ray=on_ray)
     except SimkitError as exc:
         _fail(exc)
     files = sum(len(kit["files"]) for kit in index["kits"])
