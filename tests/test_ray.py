@@ -173,3 +173,13 @@ def test_named_files_are_those_inside_the_spec_folder(tmp_path):
         "    note: not a file\n"
     )
     assert named_files(spec) == {"meshes/a.stl": b"solid a"}
+
+
+@pytest.mark.slow
+def test_publish_on_ray_lays_out_the_serial_site(local_ray, tmp_path):
+    from simkit.publish import publish
+
+    serial = publish(tmp_path / "serial" / "sim", TWO)
+    on_ray = publish(tmp_path / "ray" / "sim", TWO, on_ray=True)
+    assert on_ray == serial
+    assert _tree(tmp_path / "ray" / "sim") == _tree(tmp_path / "serial" / "sim")
