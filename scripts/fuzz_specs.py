@@ -151,7 +151,9 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -> str:
+def run_one(
+    spec: Path, out: Path, stats: dict, env: dict, build: bool = True, extra: tuple = ()
+) -> str:
     """Validate, then build and check; returns the outcome name it counted."""
     from simkit.errors import SpecError
     from simkit.spec.validate import load_spec
@@ -167,6 +169,7 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -
     if not build:
         return "valid_not_built"
     cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out), "-q"]
+    cmd += list(extra)
     start, cpu = time.monotonic(), _children_cpu()
     try:
         proc = subprocess.run(
@@ -210,13 +213,17 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -
     return "built_ok" if check.returncode == 0 else "check_rejects_exit0_kit"
 
 
-def run_shard(spec_text: str, seed: int, indices: list[int], work: str, build: bool) -> list:
+def run_shard(
+    spec_text: str, seed: int, indices: list[int], work: str, build: bool, extra: tuple = ()
+) -> list:
     """Mutate and run the specs `indices` (each from its own seed, so any shard can run on
     any machine, in any order, and a stopped run resumes); one result dict per spec."""
     data = yaml.safe_load(spec_text)
     env = {**os.environ}
-    if (REPO / "src").is_dir():
-        env["PYTHONPATH"] = str(REPO / "src")
+    if (REPO / "src").is_dir():  # this checkout's simkit first
+        env["PYTHONPATH"] = os.pathsep.join(
+            filter(None, [str(REPO / "src"), env.get("PYTHONPATH")])
+        )
     root = Path(work) / f"shard-{indices[0]:05d}"  # private: shards run side by side
     root.mkdir(parents=True, exist_ok=True)
     results = []
@@ -229,7 +236,7 @@ def run_shard(spec_text: str, seed: int, indices: list[int], work: str, build: b
         spec.write_bytes(mutated.encode("utf-8", "surrogatepass"))
         stats: dict = {"build_seconds": [], "build_cpu_seconds": []}
         before = _listing(root, out)
-        outcome = run_one(spec, out, stats, env, build=build)
+        outcome = run_one(spec, out, stats, env, build=build, extra=extra)
         outside = _listing(root, out) != before
         if outcome in ("refused", "built_ok", "build_refused", "valid_not_built"):
             shutil.rmtree(case, ignore_errors=True)
@@ -274,7 +281,8 @@ def _run_serial(args, text: str, todo: list[int], record) -> None:
     for shard in _shards(todo, args.shard_size):
         if args.max_seconds and time.monotonic() - args.begin > args.max_seconds:
             break
-        record(run_shard(text, args.seed, shard, str(args.work / "cases"), not args.validate_only))
+        work = str(args.work / "cases")
+        record(run_shard(text, args.seed, shard, work, not args.validate_only, args.extra))
 
 
 def _run_ray(args, text: str, todo: list[int], record) -> None:
@@ -287,7 +295,7 @@ def _run_ray(args, text: str, todo: list[int], record) -> None:
     task = ray.remote(num_cpus=1, max_retries=2)(run_shard)
     work = str(args.work / "cases")
     pending = [
-        task.remote(text, args.seed, shard, work, not args.validate_only)
+        task.remote(text, args.seed, shard, work, not args.validate_only, args.extra)
         for shard in _shards(todo, args.shard_size)
     ]
     while pending:
@@ -314,7 +322,10 @@ def main() -> None:
     parser.add_argument(
         "--resume", action="store_true", help="keep WORK's results; run only the specs left"
     )
+    parser.add_argument("--start", type=int, default=0, help="first spec index (a shard range)")
+    parser.add_argument("--no-step", action="store_true", help="build with --no-step")
     args = parser.parse_args()
+    args.extra = ("--no-step",) if args.no_step else ()
     sys.path.insert(0, str(REPO / "src"))
     text = args.spec.read_text()
     results_file = args.work / "results.jsonl"
@@ -326,7 +337,7 @@ def main() -> None:
         for line in results_file.read_text().splitlines():
             result = json.loads(line)
             results[result["index"]] = result
-    todo = [i for i in range(args.count) if i not in results]
+    todo = [i for i in range(args.start, args.count) if i not in results]
     args.begin = time.monotonic()
 
     def record(shard: list[dict]) -> None:
