@@ -17,6 +17,7 @@ if TYPE_CHECKING:
 
 err = Console(stderr=True, highlight=False, soft_wrap=True)
 out = Console(highlight=False, soft_wrap=True)
+RAY_HELP = "One Ray task per robot ($RAY_ADDRESS, else a local Ray); needs simkit[ray]."
 
 
 def _fail(exc: SimkitError) -> None:
@@ -80,6 +81,7 @@ def main() -> None:
     is_flag=True,
     help="Leave out step/NAME.step (the STEP assembly; saves the Open CASCADE time).",
 )
+@click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
 def build(
     targets: tuple[str, ...],
     out_dir: Path,
@@ -92,11 +94,23 @@ def build(
     remote_cache: str | None,
     usd_format: str,
     no_step: bool,
+    on_ray: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
     from simkit.kitio.cache import Stats
     from simkit.pipeline import build as run_build
 
+    if on_ray:
+        options = {"check": not no_check, "usd_format": usd_format, "step": not no_step}
+        # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)
+        options["cache_args"] = {
+            "root": cache_dir,
+            "enabled": not no_cache,
+            "readonly": cache_readonly or None,
+            "remote": remote_cache,
+        }
+        _build_on_ray(targets, out_dir, quiet, options)
+        return
     cache = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
 
     for target in targets:
@@ -119,13 +133,30 @@ def build(
             )
         except SimkitError as exc:
             _fail(exc)
-        passed = sum(f.ok for f in result.findings)
         hits = f"; cache local/remote/miss: {cache.stats.summary()}" if cache.enabled else ""
-        out.print(
-            f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed{hits}",
-            markup=False,
-        )
+        out.print(_built_line(result) + hits, markup=False)
+
+
+def _built_line(result) -> str:
+    passed = sum(f.ok for f in result.findings)
+    return (
+        f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
+        f"{result.zip_path}; {passed}/{len(result.findings)} checks passed"
+    )
+
+
+def _build_on_ray(targets: tuple[str, ...], out_dir: Path, quiet: bool, options: dict) -> None:
+    """`simkit build --ray`: one Ray task per target, published here (simkit/cluster.py)."""
+    from simkit.cluster import build_on_ray
+
+    try:
+        results = build_on_ray(targets, out_dir, None if quiet else _say, **options)
+    except SimkitError as exc:
+        _fail(exc)
+        return
+    for result in results:
+        hits = f"; cache local/remote/miss: {result.cache_hits}" if result.cache_hits else ""
+        out.print(_built_line(result) + hits, markup=False)
 
 
 def _open_cache(dir_: str | None, off: bool, readonly: bool, remote: str | None) -> Cache:
@@ -262,6 +293,7 @@ def view(kit: Path, port: int, no_browser: bool) -> None:
 @click.option("--cache-dir", type=click.Path(file_okay=False), default=None, help="As build's.")
 @click.option("--cache-readonly", is_flag=True, envvar="SIMKIT_CACHE_READONLY", help="As build's.")
 @click.option("--remote-cache", default=None, envvar="SIMKIT_REMOTE_CACHE", help="As build's.")
+@click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
 def publish(
     robots: tuple[str, ...],
     out_dir: Path,
@@ -269,19 +301,24 @@ def publish(
     cache_dir: str | None,
     cache_readonly: bool,
     remote_cache: str | None,
+    on_ray: bool,
 ) -> None:
     """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and
     index.json, as the download site serves them under /assets/sim/."""
     from simkit.publish import publish as run_publish
 
-    cache = _open_cache(cache_dir, False, cache_readonly, remote_cache)
+    if on_ray:  # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)
+        args = {"root": cache_dir, "readonly": cache_readonly or None, "remote": remote_cache}
+        options = {"on_ray": True, "cache_args": args}
+    else:
+        options = {"cache": _open_cache(cache_dir, False, cache_readonly, remote_cache)}
 
     def progress(msg: str) -> None:
         if not quiet:
             err.print(msg, markup=False)
 
     try:
-        index = run_publish(out_dir, robots or None, progress=progress, cache=cache)
+        index = run_publish(out_dir, robots or None, progress=progress, **options)
     except SimkitError as exc:
         _fail(exc)
     files = sum(len(kit["files"]) for kit in index["kits"])

@@ -291,3 +291,22 @@ def _build(
     return BuildResult(
         robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
     )
+
+
+def publish_files(
+    out_dir: Path, robot: str, files: dict[str, bytes], zip_data: bytes
+) -> tuple[Path, Path]:
+    """Publish a kit built and checked elsewhere (a Ray worker) into `out_dir` exactly as a
+    local build publishes its own: under the output folder's lock, through a staging
+    folder and one atomic commit. Returns (kit folder, zip path)."""
+    kit_name = layout.kit_dir_name(robot)
+    lock = atomic.acquire(out_dir, robot)
+    staging = atomic.staging(out_dir, robot)
+    try:
+        write_tree(staging / kit_name, files)
+        (staging / layout.zip_name(robot)).write_bytes(zip_data)
+        atomic.commit(staging, out_dir, robot)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+        atomic.release(lock)
+    return out_dir / kit_name, out_dir / layout.zip_name(robot)

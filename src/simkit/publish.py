@@ -60,10 +60,12 @@ def publish(
     out_dir: Path,
     targets: Sequence[str] | None = None,
     progress: Callable[[str], None] | None = None,
+    on_ray: bool = False,
     **build_options,
 ) -> dict:
     """Build `targets` (default: every robot in robots/), check them, and write the site
-    folder; returns the index. `build_options` go to `build.build` (cache, jobs)."""
+    folder; returns the index. `build_options` go to `build.build` (cache, jobs); `on_ray`:
+    one Ray task per robot (simkit/cluster.py), the site still written here."""
     say = progress or (lambda _msg: None)
     out_dir = Path(out_dir)
     _check_out_dir(out_dir)
@@ -71,7 +73,7 @@ def publish(
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     with atomic.locked(out_dir.parent):  # one publish into a folder at a time
         atomic.recover_folder(out_dir)
-        return _publish_locked(out_dir, names, say, build_options)
+        return _publish_locked(out_dir, names, say, {**build_options, "on_ray": on_ray})
 
 
 def _publish_locked(
@@ -86,9 +88,7 @@ def _publish_locked(
         site, work = staging / "site", staging / "kits"
         site.mkdir()
         kits = []
-        for target in names:
-            say(f"build {target}")
-            result = build(target, work, check=True, progress=say, **build_options)
+        for target, result in zip(names, _build_all(names, work, say, build_options), strict=True):
             top = layout.kit_dir_name(result.robot)
             folder = _asset_dir(target, result.robot)
             if any(kit["folder"] == f"{folder}/" for kit in kits):
@@ -123,3 +123,18 @@ def _publish_locked(
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return index
+
+
+def _build_all(names: list[str], work: Path, say: Callable[[str], None], options: dict) -> list:
+    """Every kit, built here one after another or as Ray tasks (`on_ray`), published into
+    `work` either way."""
+    options = dict(options)
+    if options.pop("on_ray", False):
+        from simkit.cluster import build_on_ray
+
+        return build_on_ray(names, work, say, check=True, **options)
+    results = []
+    for target in names:
+        say(f"build {target}")
+        results.append(build(target, work, check=True, progress=say, **options))
+    return results
