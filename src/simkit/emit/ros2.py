@@ -30,6 +30,7 @@ INSTALL_DIRS = (
     "usd",
     "glb",
     "step",
+    "sdf",
     "benchmark",
     "examples",
     "docs",
