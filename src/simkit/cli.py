@@ -100,6 +100,8 @@ def build(
             )
         except SimkitError as exc:
             _fail(exc)
+        for warning in result.warnings if not quiet else ():
+            err.print(f"warning: {warning}", markup=False)
         passed = sum(f.ok for f in result.findings)
         out.print(
             f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
