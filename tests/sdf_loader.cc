@@ -1,6 +1,7 @@
 // Loads SDFormat files with libsdformat (the parser Gazebo uses), warnings and unknown
 // elements treated as errors. Prints one line per model: name, links, joints, frames and the
 // total mass (kg); exits 1 on any error. Built by tests/test_sdf.py.
+#include <iomanip>
 #include <iostream>
 #include <sdf/sdf.hh>
 
@@ -25,7 +26,7 @@ int main(int argc, char **argv) {
     for (uint64_t k = 0; k < model->LinkCount(); ++k) {
       mass += model->LinkByIndex(k)->Inertial().MassMatrix().Mass();
     }
-    std::cout << "model " << model->Name() << " links " << model->LinkCount() << " joints "
+    std::cout << std::setprecision(12) << "model " << model->Name() << " links " << model->LinkCount() << " joints "
               << model->JointCount() << " frames " << model->FrameCount() << " mass " << mass
               << "\n";
   }
