@@ -192,3 +192,18 @@ def test_sdf_of_a_floating_base_has_a_free_canonical_link():
     first = re.search(r'<link name="([^"]+)">\s*<pose relative_to="__model__">([^<]+)<', text)
     assert first is not None and first.group(1) == robot.floating_joint.child
     assert [float(v) for v in first.group(2).split()[:3]] == list(robot.floating_joint.xyz)
+
+
+@pytest.mark.slow
+def test_a_joint_named_like_a_link_gets_a_unique_sdf_name(sdf_loader, tmp_path):
+    """URDF allows a joint and a link of one name, SDFormat does not: the SDF renames the
+    joint, libsdformat loads it and the SDF check pairs the joints by child link."""
+    from simkit.pipeline import build
+
+    spec = tmp_path / "clash.yaml"
+    spec.write_text((HERE / "specs" / "planar_2r.yaml").read_text().replace("joint_1", "link_1"))
+    result = build(str(spec), tmp_path / "out", step=False)  # raises if a check fails
+    text = (result.kit_dir / "sdf" / "planar_2r.sdf").read_text()
+    assert '<joint name="link_1_joint" type="revolute">' in text
+    assert {f.check for f in result.findings if f.check.startswith("sdf.")} >= {"sdf.fk"}
+    _expect_loaded(sdf_loader, result.kit_dir)

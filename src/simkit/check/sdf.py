@@ -15,7 +15,7 @@ import numpy as np
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
 from simkit.check.readers.sdf import read_sdf
-from simkit.check.readers.tree import MODEL, WORLD, Tree, read_urdf
+from simkit.check.readers.tree import MODEL, WORLD, Tree, TreeJoint, read_urdf
 from simkit.kitio import layout
 
 TOL = 1e-9  # both files print the same 10-significant-digit numbers (kitio/fmt.py)
@@ -98,25 +98,26 @@ def _inertials(sdf: Tree, urdf: Tree) -> list[Finding]:
 
 
 def _joints(sdf: Tree, urdf: Tree) -> list[Finding]:
-    """The URDF's joints between SDF links: same type, ends, axis, limits and place."""
-    mine = {j.name: j for j in sdf.joints}
+    """The URDF's joints between SDF links: same type, ends, axis, limits and place. Joints
+    pair up by child link (the SDF renames a joint whose name a link or frame has)."""
+    mine = _by_child(sdf)
     wanted = [j for j in urdf.joints if j.child in sdf.bodies]
-    missing = [j.name for j in wanted if j.name not in mine]
-    if missing or len(mine) != len(wanted):
-        extra = sorted(set(mine) - {j.name for j in wanted})
+    missing = [j.name for j in wanted if j.child not in mine]
+    if missing or len(sdf.joints) != len(wanted):
+        extra = sorted(j.name for j in sdf.joints if j.child not in {w.child for w in wanted})
         return [require("sdf.joints", False, f"joints not in the SDF: {missing}, extra: {extra}")]
     roots = {urdf.root, WORLD} - set(sdf.bodies)
     wrong = [
         j.name
         for j in wanted
-        if (mine[j.name].type, mine[j.name].child) != (j.type, j.child)
+        if (mine[j.child].type, mine[j.child].child) != (j.type, j.child)
         or (
-            mine[j.name].parent != j.parent
-            and not {mine[j.name].parent, j.parent} <= roots | {WORLD}
+            mine[j.child].parent != j.parent
+            and not {mine[j.child].parent, j.parent} <= roots | {WORLD}
         )
     ]
     shared = [
-        (j, mine[j.name], sorted(set(j.limits) & set(mine[j.name].limits)))
+        (j, mine[j.child], sorted(set(j.limits) & set(mine[j.child].limits)))
         for j in wanted
         if j.type in MOVABLE
     ]
@@ -124,7 +125,7 @@ def _joints(sdf: Tree, urdf: Tree) -> list[Finding]:
     ref_u, ref_s = _reference(urdf, at_zero_u), _reference(urdf, at_zero_s)
     place_u = [ref_u @ at_zero_u[j.parent] @ j.parent_to_joint for j in wanted]
     place_s = [
-        ref_s @ at_zero_s[mine[j.name].parent] @ mine[j.name].parent_to_joint for j in wanted
+        ref_s @ at_zero_s[mine[j.child].parent] @ mine[j.child].parent_to_joint for j in wanted
     ]
     return [
         require(
@@ -154,6 +155,10 @@ def _joints(sdf: Tree, urdf: Tree) -> list[Finding]:
     ]
 
 
+def _by_child(tree: Tree) -> dict[str, TreeJoint]:
+    return {j.child: j for j in tree.joints}
+
+
 def _reference(urdf: Tree, poses: dict[str, np.ndarray]) -> np.ndarray:
     """Inverse pose of the URDF's root link in a file's poses (both then share its frame)."""
     return np.linalg.inv(poses.get(urdf.root, poses[WORLD]))
@@ -163,13 +168,15 @@ def _fk(sdf: Tree, urdf: Tree) -> list[Finding]:
     """Every link and frame, SDF vs URDF, at seeded configurations within the URDF limits."""
     rng = np.random.default_rng(0)
     movable = [j for j in urdf.joints if j.type in MOVABLE]
+    mine = _by_child(sdf)
     expected, actual = [], []
     for _ in range(CONFIGS):
         q = {
             j.name: rng.uniform(j.limits.get("lower", -np.pi), j.limits.get("upper", np.pi))
             for j in movable
         }
-        pu, ps = urdf.poses(q), sdf.poses(q)
+        pu = urdf.poses(q)
+        ps = sdf.poses({mine[j.child].name: q[j.name] for j in movable if j.child in mine})
         ru, rs = _reference(urdf, pu), _reference(urdf, ps)
         names = sorted(set(pu) & set(ps) - {WORLD, MODEL})
         expected += [ru @ pu[n] for n in names]

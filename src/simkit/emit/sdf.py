@@ -6,7 +6,9 @@ is the joint frame, as in URDF), so both files carry the same numbers. A fixed b
 to `world` by the spec's root joint, at the root joint's origin; the root link (massless in
 the URDF) becomes a `<frame>` at the model origin. A floating base is the model's first,
 canonical link, free, placed at its floating joint's origin. Spec frames (tool0, ...) are
-`<frame>`s. Units: m, kg, kg m^2, rad; inertia about the centre of mass, link axes.
+`<frame>`s. A joint named like a link or frame (URDF allows it) is renamed `NAME_joint`, as
+SDFormat wants every name in a model unique. Units: m, kg, kg m^2, rad; inertia about the
+centre of mass, link axes.
 """
 
 from __future__ import annotations
@@ -42,6 +44,21 @@ def _root_frame(robot: Robot) -> str:
 
 def _frame_of(robot: Robot, link: str) -> str:
     return _root_frame(robot) if link == robot.root else link
+
+
+def joint_names(robot: Robot) -> dict[str, str]:
+    """SDF name of each joint: its own, unless a link or frame has that name (URDF allows it,
+    SDFormat wants every name in a model unique), then `NAME_joint` (`_2`, ... if taken)."""
+    taken = {link.name for link in robot.links} | {f.name for f in robot.frames} | {robot.root}
+    out: dict[str, str] = {}
+    for joint in robot.joints:
+        name, k = joint.name, 1
+        while name in taken:
+            k += 1
+            name = f"{joint.name}_joint" + (f"_{k}" if k > 2 else "")
+        taken.add(name)
+        out[joint.name] = name
+    return out
 
 
 def _inertial(el: ET.Element, link: Link) -> None:
@@ -96,12 +113,12 @@ def _collisions(el: ET.Element, link: Link, file: str) -> None:
         _mesh(sub(el, "collision", name=f"{link.name}_collision_{i:02d}"), file, path)
 
 
-def _link(robot: Robot, model: ET.Element, link: Link, joint: Joint, file: str) -> None:
+def _link(robot: Robot, model: ET.Element, link: Link, joint: Joint, file: str, names) -> None:
     el = sub(model, "link", name=link.name)
     if joint.type == "floating":
         _pose(el, joint.xyz, joint.rpy, _frame_of(robot, joint.parent))
     else:
-        _pose(el, (0, 0, 0), (0, 0, 0), joint.name)
+        _pose(el, (0, 0, 0), (0, 0, 0), names[joint.name])
     _inertial(el, link)
     if link.solid is not None:
         visual = sub(el, "visual", name=f"{link.name}_visual")
@@ -114,8 +131,8 @@ def _link(robot: Robot, model: ET.Element, link: Link, joint: Joint, file: str) 
     _collisions(el, link, file)
 
 
-def _joint(robot: Robot, model: ET.Element, joint: Joint) -> None:
-    el = sub(model, "joint", name=joint.name, type=joint.type)
+def _joint(robot: Robot, model: ET.Element, joint: Joint, name: str) -> None:
+    el = sub(model, "joint", name=name, type=joint.type)
     _pose(el, joint.xyz, joint.rpy, _frame_of(robot, joint.parent))
     parent = WORLD if joint.parent == robot.root else joint.parent
     _text(el, "parent", parent)
@@ -148,10 +165,11 @@ def emit(robot: Robot) -> dict[str, bytes]:
     if _root_frame(robot) != MODEL:
         sub(model, "frame", name=robot.root, attached_to=MODEL)
     links = {link.name: link for link in robot.links}
+    names = joint_names(robot)
     for joint in robot.joints:
         if joint.type != "floating":
-            _joint(robot, model, joint)
-        _link(robot, model, links[joint.child], joint, file)
+            _joint(robot, model, joint, names[joint.name])
+        _link(robot, model, links[joint.child], joint, file, names)
     for frame in robot.frames:
         parent = _frame_of(robot, frame.parent)
         el = sub(model, "frame", name=frame.name, attached_to=parent)
