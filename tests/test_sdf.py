@@ -156,6 +156,7 @@ def _failed(kit_dir: Path) -> set[str]:
         ),
         ("<xyz>0 0 1</xyz>", "<xyz>0 1 0</xyz>", "sdf.fk"),
         ("<upper>0.0698132</upper>", "<upper>0.07</upper>", "sdf.limits"),
+        ("<upper>0.0698132</upper>", "", "sdf.limits"),
         ("<parent>base_link</parent>", "<parent>world</parent>", "sdf.joints"),
         ("../meshes/collision/link_1_00.obj", "../meshes/collision/link_1_99.obj", "sdf.meshes"),
     ],

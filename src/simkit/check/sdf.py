@@ -116,11 +116,7 @@ def _joints(sdf: Tree, urdf: Tree) -> list[Finding]:
             and not {mine[j.child].parent, j.parent} <= roots | {WORLD}
         )
     ]
-    shared = [
-        (j, mine[j.child], sorted(set(j.limits) & set(mine[j.child].limits)))
-        for j in wanted
-        if j.type in MOVABLE
-    ]
+    shared = [(j, mine[j.child], _limit_keys(j)) for j in wanted if j.type in MOVABLE]
     at_zero_u, at_zero_s = urdf.poses({}), sdf.poses({})
     ref_u, ref_s = _reference(urdf, at_zero_u), _reference(urdf, at_zero_s)
     place_u = [ref_u @ at_zero_u[j.parent] @ j.parent_to_joint for j in wanted]
@@ -145,14 +141,21 @@ def _joints(sdf: Tree, urdf: Tree) -> list[Finding]:
         ),
         compare(
             "sdf.limits",
-            "joint limits and dynamics both files give, SDF vs URDF",
+            "the URDF's joint limits and dynamics, SDF vs URDF",
             [u.limits[k] for u, _, keys in shared for k in keys],
-            [s.limits[k] for _, s, keys in shared for k in keys],
+            [s.limits.get(k, np.nan) for _, s, keys in shared for k in keys],
             TOL,
             "",
         ),
         compare("sdf.joint_poses", "joint frames at zero, SDF vs URDF", place_u, place_s, TOL, ""),
     ]
+
+
+def _limit_keys(joint: TreeJoint) -> list[str]:
+    """The URDF joint's limits and dynamics the SDF must repeat: all it gives, but an effort
+    or velocity of 0 (simkit's URDF for "not known"; the SDF leaves those out)."""
+    unknown = {k for k in ("effort", "velocity") if joint.limits.get(k) == 0}
+    return sorted(set(joint.limits) - unknown)
 
 
 def _by_child(tree: Tree) -> dict[str, TreeJoint]:

@@ -100,8 +100,6 @@ def read_sdf(path: Path) -> Tree:
         )
     moved = {j.child for j in tree.joints}
     tree.placed = {name: at(name) for name in tree.bodies if name not in moved}
-    moved = {j.child for j in tree.joints}
-    tree.placed = {name: at(name) for name in tree.bodies if name not in moved}
     for frame in model.findall("frame"):
         attached = frame.get("attached_to") or MODEL
         tree.frames[frame.get("name")] = (
