@@ -59,7 +59,11 @@ def _build(
 
 
 def _triangles(path: Path) -> int:
-    return int.from_bytes(path.read_bytes()[80:84], "little")
+    """Triangles of a kit mesh: a binary STL's count, or an OBJ's `f` lines (collision)."""
+    data = path.read_bytes()
+    if path.suffix == ".obj":
+        return sum(line.startswith(b"f ") for line in data.splitlines())
+    return int.from_bytes(data[80:84], "little")
 
 
 def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] = ()) -> dict:

@@ -88,8 +88,8 @@ def test_each_kind_of_change(rosie_1000, copy):
     mesh = from_stl(stl.read_bytes())
     stl.write_bytes(to_stl(mesh._replace(vertices=mesh.vertices * 1.1), "link_4"))
     # one more convex piece for link_1, and README removed
-    pieces = sorted((copy / "meshes" / "collision").glob("link_1_*.stl"))
-    shutil.copy(pieces[0], copy / "meshes" / "collision" / f"link_1_{len(pieces):02d}.stl")
+    pieces = sorted((copy / "meshes" / "collision").glob("link_1_*.obj"))
+    shutil.copy(pieces[0], copy / "meshes" / "collision" / f"link_1_{len(pieces):02d}.obj")
     (copy / "README.md").unlink()
 
     report = diff_kits(rosie_1000.kit_dir, copy)
@@ -119,7 +119,7 @@ def test_each_kind_of_change(rosie_1000, copy):
     assert np.allclose(np.array(box.new) / np.array(box.old), 1.1, rtol=1e-5)
     pieces_change = by_key[("collision", "link_1", "modified", "pieces")]
     assert pieces_change.new == pieces_change.old + 1
-    assert report.added == [f"meshes/collision/link_1_{len(pieces):02d}.stl"]
+    assert report.added == [f"meshes/collision/link_1_{len(pieces):02d}.obj"]
     assert report.removed == ["README.md"]
     assert set(report.changed) == {"robot.json", "meshes/visual/link_4.stl"}
     text = to_markdown(report)

@@ -218,14 +218,11 @@ def test_diff_html_gets_a_collision_row_when_collision_pieces_change(rosie_1000,
     old = rosie_1000.kit_dir
     new = tmp_path / "new"
     shutil.copytree(old, new)
-    piece = new / "meshes/collision/link_2_00.stl"
-    stl = bytearray(piece.read_bytes())
-    count = int.from_bytes(stl[80:84], "little")
-    floats = np.frombuffer(bytes(stl[84:]), dtype=np.uint8).reshape(count, 50)
-    verts = floats[:, 12:48].copy().view("<f4").reshape(count, 3, 3) * np.float32(1.3)
-    rows = floats.copy()
-    rows[:, 12:48] = verts.astype("<f4").view(np.uint8).reshape(count, 36)
-    piece.write_bytes(bytes(stl[:84]) + rows.tobytes())
+    from simkit.kitio.obj import from_obj, to_obj
+
+    piece = new / "meshes/collision/link_2_00.obj"
+    mesh = from_obj(piece.read_bytes())
+    piece.write_bytes(to_obj(mesh._replace(vertices=mesh.vertices * 1.3), "link_2_00"))
     report = tmp_path / "report.html"
     result = CliRunner().invoke(main, ["diff", str(old), str(new), "--html", str(report)])
     assert result.exit_code == 1, result.output

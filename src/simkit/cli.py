@@ -133,6 +133,8 @@ def build(
             )
         except SimkitError as exc:
             _fail(exc)
+        for warning in result.warnings if not quiet else ():
+            err.print(f"warning: {warning}", markup=False)
         hits = f"; cache local/remote/miss: {cache.stats.summary()}" if cache.enabled else ""
         out.print(_built_line(result) + hits, markup=False)
 
@@ -155,6 +157,8 @@ def _build_on_ray(targets: tuple[str, ...], out_dir: Path, quiet: bool, options:
         _fail(exc)
         return
     for result in results:
+        for warning in result.warnings if not quiet else ():
+            err.print(f"warning: {warning}", markup=False)
         hits = f"; cache local/remote/miss: {result.cache_hits}" if result.cache_hits else ""
         out.print(_built_line(result) + hits, markup=False)
 

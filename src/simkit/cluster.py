@@ -71,6 +71,7 @@ class Built:
     error: str | None = None
     exit_code: int = 0
     cache_hits: str = ""  # the worker's "local/remote/miss" counts per stage
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -188,7 +189,14 @@ def run_job(job: Job, expected: str) -> Built:
             result = build(target, Path(tmp) / "out", **options)
             hits = cache.stats.summary() if cache.enabled else ""
             zip_bytes = result.zip_path.read_bytes()
-            return Built(result.robot, result.files, zip_bytes, result.findings, cache_hits=hits)
+            return Built(
+                result.robot,
+                result.files,
+                zip_bytes,
+                result.findings,
+                cache_hits=hits,
+                warnings=result.warnings,
+            )
         except SimkitError as exc:
             message = str(exc).replace(f"{folder}{os.sep}", "")
             return Built(job.target, {}, b"", [], message, exc.exit_code)
@@ -240,7 +248,13 @@ def build_on_ray(
         kit_dir, zip_path = publish_files(out_dir, built.robot, built.files, built.zip_bytes)
         results.append(
             RayBuildResult(
-                built.robot, kit_dir, zip_path, built.files, built.findings, built.cache_hits
+                built.robot,
+                kit_dir,
+                zip_path,
+                built.files,
+                built.findings,
+                warnings=built.warnings,
+                cache_hits=built.cache_hits,
             )
         )
     return results

@@ -22,7 +22,7 @@ from simkit.errors import SimkitError
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.kitio.kitread import read_folder_safely, read_zip_safely, robot_json_problem
-from simkit.kitio.stl import from_stl
+from simkit.kitio.obj import read_mesh
 
 #: robot.json joint fields compared, with their units (angles of prismatic joints are m).
 JOINT_FIELDS = {
@@ -49,7 +49,7 @@ LINK_FIELDS = {"mass": "kg", "com": "m", "inertia": "kg m^2"}
 #: robot.json keys the sections above cover (and `*_deg` twins, which follow the radians).
 COVERED_KEYS = {"joints", "fixed_joints", "links"}
 ANGLE_FIELDS = {"lower", "upper", "max_velocity", "origin_rpy", "springref"}
-COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.stl$")
+COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.(?:stl|obj)$")
 
 
 @dataclass(frozen=True)
@@ -149,9 +149,10 @@ def _entities(
 
 def _mesh_stats(path: str, data: bytes) -> dict:
     try:
-        mesh = from_stl(data)
+        mesh = read_mesh(path, data)
     except (ValueError, IndexError) as exc:
-        raise SimkitError(f"{path}: not a binary STL ({exc})") from None
+        kind = "an OBJ" if path.endswith(".obj") else "a binary STL"
+        raise SimkitError(f"{path}: not {kind} ({exc})") from None
     tri = mesh.vertices[mesh.faces]
     volume = float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6)
     size = (mesh.vertices.max(axis=0) - mesh.vertices.min(axis=0)).tolist() if len(tri) else []
@@ -161,7 +162,7 @@ def _mesh_stats(path: str, data: bytes) -> dict:
 def _meshes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
     out = []
     for path in sorted(set(old) & set(new)):
-        if not path.endswith(".stl") or old[path] == new[path]:
+        if not path.endswith((".stl", ".obj")) or old[path] == new[path]:
             continue
         a, b = _mesh_stats(path, old[path]), _mesh_stats(path, new[path])
         for key, unit in (("volume", "m^3"), ("bbox", "m"), ("triangles", "")):

@@ -17,6 +17,7 @@ from simkit.check import run_checks_cached
 from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
+from simkit.emit.ros2 import package_warning
 from simkit.errors import CheckFailed, SpecError, UnknownRobot
 from simkit.kitio import atomic, confine, forked, layout
 from simkit.kitio.archive import zip_bytes
@@ -49,6 +50,8 @@ class BuildResult:
     zip_path: Path
     files: dict[str, bytes]
     findings: list[Finding] = field(default_factory=list)
+    #: one-line warnings about the spec (e.g. package.xml's maintainer left to the default)
+    warnings: tuple[str, ...] = ()
 
 
 def find_spec(target: str) -> tuple[Path, str]:
@@ -288,8 +291,14 @@ def _build(
     finally:
         shutil.rmtree(staging, ignore_errors=True)
         atomic.release(lock)
+    warning = package_warning(robot)
     return BuildResult(
-        robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
+        robot.name,
+        out_dir / kit_name,
+        out_dir / layout.zip_name(robot.name),
+        files,
+        findings,
+        (warning,) if warning else (),
     )
 
 

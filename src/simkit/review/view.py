@@ -3,7 +3,8 @@
 The page (`web/index.html`, `web/viewer.js`) and a pinned three.js (`web/vendor/three/`, MIT)
 come from the simkit package; everything else from the kit folder (or a kit zip, unpacked to a
 temporary folder): robot.json for joints, limits, named poses and frames, the GLB, and
-`meshes/collision/*.stl` for the collision pieces (the GLB holds the visual geometry only).
+`meshes/collision/*.obj` (older kits: `.stl`) for the collision pieces (the GLB holds the
+visual geometry only).
 No request leaves the machine. URL layout: `/` the page, `/vendor/...` three.js,
 `/kit/PATH` a kit file, `/kit-files.json` the sorted list of kit files.
 """
@@ -30,6 +31,7 @@ TYPES = {
     ".json": "application/json",
     ".glb": "model/gltf-binary",
     ".stl": "model/stl",
+    ".obj": "model/obj",
     ".png": "image/png",
 }
 

@@ -10,7 +10,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { STLLoader } from 'three/addons/loaders/STLLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
-const COLLISION_PIECE = /^meshes\/collision\/(.+)_(\d+)\.stl$/;
+const COLLISION_PIECE = /^meshes\/collision\/(.+)_(\d+)\.(stl|obj)$/;
 const PALETTE = [0xf25a1a, 0x1a8cf2, 0x33bf4d, 0xd933b3, 0xf2bf1a];
 const api = { ready: false, error: null, joints: [] };
 window.simkitViewer = api;
@@ -168,6 +168,28 @@ function buildFrames(robot, model, size, render) {
   if (!names.length) box.textContent = 'none named in robot.json';
 }
 
+// A kit's OBJ collision piece (kitio/obj.py: `v x y z` and `f a b c` lines) as a geometry.
+async function loadObj(url) {
+  const text = await (await fetch(url)).text();
+  const vertices = [];
+  const corners = [];
+  for (const line of text.split('\n')) {
+    const parts = line.trim().split(/\s+/);
+    if (parts[0] === 'v') vertices.push(parts.slice(1, 4).map(Number));
+    if (parts[0] !== 'f') continue;
+    const ring = parts.slice(1).map((t) => {
+      const i = parseInt(t.split('/')[0], 10);
+      return i > 0 ? i - 1 : vertices.length + i;
+    });
+    for (let k = 1; k + 1 < ring.length; k++) corners.push(ring[0], ring[k], ring[k + 1]);
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(
+    corners.flatMap((i) => vertices[i]), 3));
+  geometry.computeVertexNormals();
+  return geometry;
+}
+
 async function buildCollision(files, model, render) {
   const box = document.getElementById('collision');
   const byLink = new Map();
@@ -189,7 +211,8 @@ async function buildCollision(files, model, render) {
     const group = new THREE.Group();
     group.name = `${link}_collision`;
     group.visible = false;
-    const geometries = await Promise.all(paths.map((p) => loader.loadAsync(`kit/${p}`)));
+    const geometries = await Promise.all(paths.map((p) => (p.endsWith('.obj')
+      ? loadObj(`kit/${p}`) : loader.loadAsync(`kit/${p}`))));
     geometries.forEach((geometry) => {
       const material = new THREE.MeshStandardMaterial({
         color: PALETTE[count++ % PALETTE.length], transparent: true, opacity: 0.55,
