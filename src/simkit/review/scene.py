@@ -39,7 +39,7 @@ COLLISION_ALPHA, VISUAL_FAINT = 0.55, 0.25
 MARGIN = 1.15
 #: framing: fixtures (geometry welded to the world: a wall plate, a pedestal) count only
 #: within this fraction of the moving links' extent around them, so the robot fills the frame
-FIXTURE_ROOM = 0.25
+FIXTURE_ROOM = 0.1
 POSE_NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
 
 #: a dark blue-grey floor and backdrop, so white, grey and coloured robots all stand out
@@ -265,15 +265,17 @@ def robot_points(scene: KitScene, data) -> np.ndarray:
 
 
 def framing_points(points: np.ndarray, moving: np.ndarray) -> np.ndarray:
-    """The points a camera frames: the moving links whole, and the fixtures only as far as
-    FIXTURE_ROOM of the moving links' extent around them (clamped), so that a 1 m wall plate
-    does not shrink a 0.3 m arm to a corner of the picture. Without moving links (a kit of
-    fixed links only), every point counts."""
+    """The points a camera frames: the moving links, and of the fixtures only the points
+    within FIXTURE_ROOM of the moving links' extent around their bounding box, so that a 1 m
+    wall plate does not shrink a 0.3 m arm to a corner of the picture (issue 25). Without
+    moving links (a kit of fixed links only), every point counts."""
     if not moving.any():
         return points
     lo, hi = points[moving].min(axis=0), points[moving].max(axis=0)
     room = FIXTURE_ROOM * (hi - lo).max()
-    return np.concatenate([points[moving], np.clip(points[~moving], lo - room, hi + room)])
+    fixed = points[~moving]
+    near = np.all((fixed >= lo - room) & (fixed <= hi + room), axis=1)
+    return np.concatenate([points[moving], fixed[near]])
 
 
 def collision_colours(scene: KitScene, on: bool) -> None:
