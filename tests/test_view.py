@@ -229,3 +229,18 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
     view = image[:, 320:]  # right of the side panel: the 3D view
     assert view.std() > 10 and len(np.unique(view.reshape(-1, 3), axis=0)) > 200
     (tmp_path / "viewer.png").write_bytes(shot)
+
+
+@pytest.mark.parametrize("name", ["../evil.txt", "/abs/evil.txt", "kit/../../evil.txt"])
+def test_zip_entries_outside_the_kit_are_refused(tmp_path, name):
+    import zipfile
+
+    bad = tmp_path / "sub" / "escape.zip"
+    bad.parent.mkdir()
+    with zipfile.ZipFile(bad, "w") as archive:
+        archive.writestr("kit/robot.json", '{"name": "tiny", "joints": []}')
+        archive.writestr(name, b"outside")
+    with pytest.raises(SimkitError) as info:
+        serve_kit(bad, 0, open_browser=False)
+    assert "\n" not in str(info.value)
+    assert not list(tmp_path.rglob("evil.txt"))
