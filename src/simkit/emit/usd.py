@@ -120,7 +120,7 @@ def _points(vertices: np.ndarray):
 
 
 def _mesh(stage, path: str, mesh: Mesh, normals: bool):
-    from pxr import Gf, UsdGeom, Vt
+    from pxr import Gf, Sdf, UsdGeom, Vt
 
     geom = UsdGeom.Mesh.Define(stage, path)
     points, arr = _points(mesh.vertices)
@@ -130,10 +130,12 @@ def _mesh(stage, path: str, mesh: Mesh, normals: bool):
     lo, hi = arr.min(axis=0), arr.max(axis=0)
     geom.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*lo.tolist()), Gf.Vec3f(*hi.tolist())]))
     if normals:
-        # the GLB's normals (kitio/normals.py): smooth on curved surfaces, sharp at creases
+        # the GLB's normals (kitio/normals.py): smooth on curved surfaces, sharp at creases;
+        # a primvar, one per face corner, so both files shade alike
         data = corner_normals(mesh.vertices, mesh.faces).reshape(-1, 3).astype(np.float32)
-        geom.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(data)))
-        geom.SetNormalsInterpolation(UsdGeom.Tokens.faceVarying)
+        UsdGeom.PrimvarsAPI(geom).CreatePrimvar(
+            "normals", Sdf.ValueTypeNames.Normal3fArray, UsdGeom.Tokens.faceVarying
+        ).Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(data)))
     geom.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     return geom
 
