@@ -79,7 +79,8 @@ def test_stage_layout(rosie_1000):
     # kp = effort_peak / 0.01 rad = 33000 N m/rad -> per degree
     assert drive.GetStiffnessAttr().Get() == pytest.approx(33000 * np.pi / 180, rel=1e-6)
     visual = UsdGeom.Mesh(stage.GetPrimAtPath("/rosie_1000/link_2/visuals/link_2"))
-    assert len(visual.GetNormalsAttr().Get()) == len(visual.GetFaceVertexIndicesAttr().Get())
+    normals = UsdGeom.PrimvarsAPI(visual).GetPrimvar("normals").Get()  # issue 25: a primvar
+    assert len(normals) == len(visual.GetFaceVertexIndicesAttr().Get())
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
     text = (rosie_1000.kit_dir / USDA).read_text(encoding="utf-8")
