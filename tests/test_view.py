@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from simkit.errors import SimkitError
+from simkit.kitio.resources import robot_names
 from simkit.review.view import WEB, serve_kit, start_server
 
 CHROMIUM = os.environ.get("SIMKIT_CHROMIUM") or shutil.which("chromium")
@@ -244,3 +245,40 @@ def test_zip_entries_outside_the_kit_are_refused(tmp_path, name):
         serve_kit(bad, 0, open_browser=False)
     assert "\n" not in str(info.value)
     assert not list(tmp_path.rglob("evil.txt"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", robot_names())
+def test_viewer_frames_the_whole_robot_in_every_pose(kit_factory, name, tmp_path):
+    """Issue 25: the camera is fitted to every named pose, not home alone (the flange of
+    rosie_1000 left the canvas in "stretched")."""
+    if CHROMIUM is None:
+        if os.environ.get("SIMKIT_REQUIRE_RENDER"):
+            pytest.fail("no chromium on PATH (Debian: apt-get install chromium)")
+        pytest.skip("no chromium on PATH (Debian: apt-get install chromium)")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
+    kit = kit_factory(name).kit_dir
+    poses = json.loads((kit / "robot.json").read_text())["poses"]
+    server = start_server(kit, 0)
+    boxes = {}
+    try:
+        with sync_api.sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, args=FLAGS)
+            page = browser.new_page(viewport={"width": 900, "height": 600})
+            page.goto(f"http://127.0.0.1:{server.server_address[1]}/")
+            page.wait_for_function(
+                "window.simkitViewer.ready || window.simkitViewer.error", timeout=120_000
+            )
+            assert page.evaluate("window.simkitViewer.error") is None
+            for pose in poses:
+                page.click(f'button[data-pose="{pose}"]')
+                boxes[pose] = page.evaluate("simkitViewer.screenBox()")
+                (tmp_path / f"{pose}.png").write_bytes(page.screenshot())
+            browser.close()
+    finally:
+        server.shutdown()
+        server.server_close()
+    for pose, box in boxes.items():
+        lo, hi = np.array(box["lo"]), np.array(box["hi"])
+        assert (lo >= -1).all() and (hi <= 1).all(), f"{name} {pose}: leaves the canvas {box}"
+        assert ((hi - lo) / 2).max() > 0.3, f"{name} {pose}: the robot is a speck {box}"
