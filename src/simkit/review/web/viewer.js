@@ -71,29 +71,69 @@ function visibleVertices(object, visit) {
   });
 }
 
+// The extent on the canvas, in normalised device coordinates, of the visible vertices of
+// `object` in every pose of `poses` (each a list of joint values for `setPose`).
+function poseBox(camera, object, poses, setPose) {
+  const lo = [Infinity, Infinity];
+  const hi = [-Infinity, -Infinity];
+  camera.updateMatrixWorld(true);
+  for (const values of poses) {
+    setPose(values);
+    visibleVertices(object, (p) => {
+      p.project(camera);
+      lo[0] = Math.min(lo[0], p.x); lo[1] = Math.min(lo[1], p.y);
+      hi[0] = Math.max(hi[0], p.x); hi[1] = Math.max(hi[1], p.y);
+    });
+  }
+  return { lo, hi };
+}
+
 // Frame the robot in every named pose (issue 25: with home alone, the flange left the canvas
-// in "stretched"): a bounding sphere of the vertices of all poses, seen whole by the narrower
-// of the vertical and horizontal fields of view.
+// in "stretched"): first a bounding sphere of the vertices of all poses, seen whole by the
+// narrower field of view; then a few steps that centre the poses' extent on the canvas and
+// move in until it fills FILL of the canvas in its longer direction.
+const FILL = 0.85;
 function frameCamera(view, object, poses, setPose) {
+  const { camera, controls } = view;
   const box = new THREE.Box3();
   for (const values of poses) {
     setPose(values);
     visibleVertices(object, (p) => box.expandByPoint(p));
   }
   if (box.isEmpty()) box.setFromObject(object);
-  const centre = box.getCenter(new THREE.Vector3());
+  const target = box.getCenter(new THREE.Vector3());
   const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.05);
-  const halfV = THREE.MathUtils.degToRad(view.camera.fov / 2);
-  const halfH = Math.atan(Math.tan(halfV) * Math.min(view.camera.aspect, 1));
-  const distance = (1.05 * radius) / Math.sin(Math.min(halfV, halfH));
+  const halfV = THREE.MathUtils.degToRad(camera.fov / 2);
+  const halfH = Math.atan(Math.tan(halfV) * camera.aspect);
+  let distance = (1.05 * radius) / Math.sin(Math.min(halfV, halfH));
   // from +x, -y (kit frame) and above; the kit's (x, y, z) is three's (x, z, -y)
   const direction = new THREE.Vector3(1.2, 0.8, 1.6).normalize();
-  view.camera.position.copy(centre).addScaledVector(direction, distance);
-  view.camera.near = distance / 100;
-  view.camera.far = distance * 100;
-  view.camera.updateProjectionMatrix();
-  view.controls.target.copy(centre);
-  view.controls.update();
+  const place = () => {
+    camera.position.copy(target).addScaledVector(direction, distance);
+    camera.near = distance / 100;
+    camera.far = distance * 100;
+    camera.lookAt(target);
+    camera.updateProjectionMatrix();
+  };
+  place();
+  for (let step = 0; step < 6; step++) {
+    const { lo, hi } = poseBox(camera, object, poses, setPose);
+    const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
+    const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+    target.addScaledVector(right, ((lo[0] + hi[0]) / 2) * Math.tan(halfH) * distance);
+    target.addScaledVector(up, ((lo[1] + hi[1]) / 2) * Math.tan(halfV) * distance);
+    const half = Math.max(hi[0] - lo[0], hi[1] - lo[1]) / 2;
+    distance *= Math.min(Math.max(half / FILL, 0.5), 2);
+    place();
+  }
+  for (let step = 0; step < 20; step++) { // never closer than the whole robot allows
+    const { lo, hi } = poseBox(camera, object, poses, setPose);
+    if (Math.min(...lo) >= -0.95 && Math.max(...hi) <= 0.95) break;
+    distance *= 1.1;
+    place();
+  }
+  controls.target.copy(target);
+  controls.update();
   const grid = new THREE.GridHelper(radius * 4, 20, 0x5b6a7e, 0x3a4656);
   grid.position.y = Math.min(box.min.y, 0);
   view.scene.add(grid);
