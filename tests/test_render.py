@@ -110,6 +110,61 @@ def test_framing_keeps_fixtures_only_near_the_moving_links():
     assert (alone == plate).all()
 
 
+def _luminance(rgb) -> float:
+    """WCAG relative luminance of an sRGB colour (0..1 channels)."""
+    c = np.asarray(rgb, float)[:3]
+    lin = np.where(c <= 0.03928, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return float(lin @ (0.2126, 0.7152, 0.0722))
+
+
+def test_floor_and_backdrop_contrast_with_every_light_robot_material():
+    """Issue 25: a white robot on a light floor had low contrast. Every light material of the
+    five robots (luminance above 0.3) stands out from the floor's and the sky's colours by a
+    WCAG contrast ratio of at least 3."""
+    import xml.etree.ElementTree as ET
+
+    from simkit.pipeline import model_from_spec
+    from simkit.review.scene import SCENE_ASSETS
+
+    assets = ET.fromstring(SCENE_ASSETS)
+    backdrop = [
+        [float(v) for v in texture.get(key).split()]
+        for texture in assets.iter("texture")
+        for key in ("rgb1", "rgb2", "markrgb")
+        if texture.get(key)
+    ]
+    light = [
+        (name, rgba)
+        for robot in robot_names()
+        for name, rgba in model_from_spec(robot).materials
+        if _luminance(rgba) > 0.3 and rgba[3] == 1
+    ]
+    assert len(light) >= 3  # white shells, light greys, turquoise
+    for name, rgba in light:
+        for colour in backdrop:
+            dark, bright = sorted((_luminance(colour), _luminance(rgba)))
+            assert (bright + 0.05) / (dark + 0.05) >= 3, (name, colour)
+
+
+def test_shadow_box_covers_the_robot_and_the_floor_in_view():
+    from simkit.review.scene import shadow_clip
+
+    points = np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.9]])
+    light = np.array([-0.4, 0.4, -0.82])
+    centre = points.mean(axis=0)
+    near = fit_camera(Camera(135.0, -20.0), points, 45.0, 4 / 3)
+    far = Camera(135.0, -20.0, 3 * near.distance, near.lookat)
+    clip = shadow_clip(near, 45.0, 4 / 3, points, 0.0, centre, light)
+    d = points - centre
+    across = d - np.outer(d @ light, light) / (light @ light)
+    assert clip >= np.linalg.norm(across, axis=1).max()  # the robot
+    assert shadow_clip(far, 45.0, 4 / 3, points, 0.0, centre, light) > 2 * clip  # more floor
+    up = Camera(135.0, 30.0, near.distance, near.lookat)  # looking up: no floor at the bottom
+    assert shadow_clip(up, 45.0, 4 / 3, points, 0.0, centre, light) == pytest.approx(
+        np.linalg.norm(across, axis=1).max()
+    )
+
+
 def test_clean_shadows_removes_speckle_and_keeps_shadows():
     plain = np.full((40, 40, 3), 120, dtype=np.uint8)
     shadowed = plain.copy()

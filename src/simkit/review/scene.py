@@ -47,7 +47,7 @@ POSE_NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
 SCENE_ASSETS = """
 <asset>
   <texture name="simkit_render_sky" type="skybox" builtin="gradient" width="64" height="384"
-    rgb1="0.36 0.42 0.5" rgb2="0.12 0.14 0.18" />
+    rgb1="0.26 0.3 0.36" rgb2="0.12 0.14 0.18" />
   <texture name="simkit_render_floor" type="2d" builtin="checker" width="256" height="256"
     rgb1="0.2 0.25 0.32" rgb2="0.16 0.2 0.26" mark="edge" markrgb="0.26 0.31 0.38" />
   <material name="simkit_render_floor" texture="simkit_render_floor" texrepeat="4 4"
