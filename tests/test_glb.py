@@ -268,3 +268,18 @@ def test_glb_normals_are_unit_and_point_outward(name):
         centroid = positions.mean(axis=0)
         assert np.einsum("ij,ij->i", normals, positions - centroid).sum() > 0
     assert count == sum(link.solid is not None for link in robot.links)
+
+
+def test_normals_are_the_same_in_any_chunking_of_a_many_faced_vertex(monkeypatch):
+    """A cone's apex is shared by 1600 faces (2.6 million corner pairs): the pairs go in
+    bounded chunks, and the normals do not depend on the chunk size."""
+    import manifold3d as mf
+
+    from simkit.derive.solids import to_mesh
+    from simkit.kitio import normals
+
+    cone = to_mesh(mf.Manifold.cylinder(0.1, 0.05, 0.0, 1600))
+    whole = normals.corner_normals(cone.vertices, cone.faces)
+    monkeypatch.setattr(normals, "PAIRS_PER_CHUNK", 5000)
+    assert np.array_equal(normals.corner_normals(cone.vertices, cone.faces), whole)
+    np.testing.assert_allclose(np.linalg.norm(whole, axis=2), 1.0, atol=1e-6)

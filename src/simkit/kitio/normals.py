@@ -45,15 +45,40 @@ def _corner_angles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return angles
 
 
-def _pairs(vertex_of_corner: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Every ordered pair (a, b) of corners at the same vertex, a == b included."""
+#: corner pairs handled at once: bounds memory on a vertex shared by thousands of faces
+PAIRS_PER_CHUNK = 1 << 21
+
+
+def _pairs(vertex_of_corner: np.ndarray, limit: int | None = None):
+    """Every ordered pair (a, b) of corners at the same vertex, a == b included, in chunks of
+    about `limit` pairs (one vertex's corners in row blocks where it alone has more). The
+    pairs come in the same order however they are chunked."""
+    limit = limit or PAIRS_PER_CHUNK
     order = np.argsort(vertex_of_corner, kind="stable")
     ids = vertex_of_corner[order]
     starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
     sizes = np.diff(np.r_[starts, len(ids)])
+    first = 0
+    while first < len(starts):
+        cost = np.cumsum(sizes[first:] ** 2)
+        last = first + max(1, int(np.searchsorted(cost, limit, side="right")))
+        if last - first == 1 and sizes[first] ** 2 > limit:  # one vertex, many faces
+            group = order[starts[first] : starts[first] + sizes[first]]
+            rows = max(1, limit // int(sizes[first]))
+            for r in range(0, len(group), rows):
+                block = group[r : r + rows]
+                yield np.repeat(block, len(group)), np.tile(group, len(block))
+        else:
+            yield _group_pairs(order, starts[first:last], sizes[first:last])
+        first = last
+
+
+def _group_pairs(order: np.ndarray, starts: np.ndarray, sizes: np.ndarray):
+    """All pairs within each group of sorted positions starts[i] .. starts[i] + sizes[i]."""
     group = np.repeat(np.arange(len(starts)), sizes)  # group of each sorted position
+    positions = np.arange(starts[0], starts[0] + int(sizes.sum()))  # the groups are contiguous
     reps = sizes[group]
-    a = np.repeat(np.arange(len(ids)), reps)
+    a = np.repeat(positions, reps)
     offset = np.arange(int(reps.sum())) - np.repeat(np.cumsum(reps) - reps, reps)
     b = np.repeat(starts[group], reps) + offset
     return order[a], order[b]
@@ -68,15 +93,15 @@ def corner_normals(
     vertex = welded.reshape(-1)[faces].reshape(-1)  # welded vertex of each corner
     fn = np.repeat(face_normals(vertices, faces), 3, axis=0)  # face normal of each corner
     weighted = fn * _corner_angles(vertices, faces).reshape(-1, 1)
-    a, b = _pairs(vertex)
-    near = np.einsum("ij,ij->i", fn[a], fn[b]) >= math.cos(math.radians(crease_deg))
-    out = np.zeros_like(fn)
-    np.add.at(out, a[near], weighted[b[near]])
+    cos = math.cos(math.radians(crease_deg))
+    out, spare = np.zeros_like(fn), np.zeros_like(fn)
+    for a, b in _pairs(vertex):
+        near = np.einsum("ij,ij->i", fn[a], fn[b]) >= cos
+        np.add.at(out, a[near], weighted[b[near]])
+        np.add.at(spare, a, weighted[b])
     # a degenerate face has no direction of its own: it takes its vertex's mean normal
     lost = np.linalg.norm(out, axis=1) < 1e-12
     if lost.any():
-        spare = np.zeros_like(fn)
-        np.add.at(spare, a, weighted[b])
         out[lost] = spare[lost]
         out[np.linalg.norm(out, axis=1) < 1e-12] = (0.0, 0.0, 1.0)
     out /= np.linalg.norm(out, axis=1, keepdims=True)
