@@ -63,6 +63,11 @@ def _cameras(scenes: list, camera, size: tuple[int, int], poses: list[str]) -> d
     return cameras
 
 
+#: extents: the widest shadow box (a camera looking level sees floor up to the horizon; the
+#: box's 4096 texels would get too coarse for the robot's own shadows)
+MAX_SHADOW_CLIP = 8.0
+
+
 def _place_shadows(model, camera, fovy: float, aspect: float, points, floor_z: float) -> None:
     """The shadow-casting lights look at the model's centre from outside the robot, and their
     shadow box covers the robot and the floor in view (`scene.shadow_clip`)."""
@@ -75,7 +80,8 @@ def _place_shadows(model, camera, fovy: float, aspect: float, points, floor_z: f
         direction = np.array(model.light_dir[light])
         model.light_pos[light] = centre - direction * 3.0 * extent
         half = shadow_clip(camera, fovy, aspect, points, floor_z, centre, direction)
-        model.vis.map.shadowclip = max(model.vis.map.shadowclip, 1.05 * half / extent)
+        clip = min(1.05 * half / extent, MAX_SHADOW_CLIP)
+        model.vis.map.shadowclip = max(model.vis.map.shadowclip, clip)
 
 
 def _renderer(scene, size: tuple[int, int]):
