@@ -172,7 +172,7 @@ class Evaluator:
         owner, key = self.eval(node.value), self.eval(node.slice)
         if isinstance(key, str) and key.startswith("__"):
             raise Refused(f"Python object access refused: '[{key!r}]'")
-        if not isinstance(owner, str | list | tuple | dict | range | self.namespaces):
+        if not isinstance(owner, (str, list, tuple, dict, range, *self.namespaces)):
             raise Refused(f"Python object access refused: subscript of {type(owner).__name__}")
         return owner[key]
 

@@ -23,6 +23,7 @@ import os
 import threading
 from contextlib import contextmanager
 from pathlib import Path
+from xml.sax.saxutils import escape
 
 from simkit.errors import SpecError
 from simkit.importer import lenient
@@ -105,7 +106,8 @@ class _Run:
         line = None
         try:
             lines = Path(file).read_text(encoding="utf-8", errors="replace").splitlines()
-            line = next((i + 1 for i, t in enumerate(lines) if text and text in t), None)
+            forms = [f for f in (text, escape(text), escape(text, {'"': "&quot;"})) if f]
+            line = next((i + 1 for i, t in enumerate(lines) if any(f in t for f in forms)), None)
         except OSError:
             pass
         field = "xacro" if isinstance(exc, Limit) else "xacro expression"
