@@ -9,6 +9,7 @@ from __future__ import annotations
 import codecs
 import re
 from collections.abc import Callable
+from dataclasses import dataclass
 
 DECLARATION = re.compile(rb"<\?xml\s[^>]*?\?>")
 VERSION = re.compile(rb"""version\s*=\s*["']([^"']*)["']""")
@@ -16,6 +17,18 @@ ENCODING = re.compile(rb"""encoding\s*=\s*["']([^"']*)["']""")
 BOM = codecs.BOM_UTF8
 #: `$(command args...)` as roslaunch and xacro write it (no nested parentheses)
 SUBSTITUTION = re.compile(r"\$\(\s*([A-Za-z_]+)((?:\s+[^()\s]+)*)\s*\)")
+
+
+@dataclass(frozen=True)
+class Position:
+    """A place in the file that is no element (an XML declaration): reads like one for
+    the report (tag, sourceline, get)."""
+
+    tag: str
+    sourceline: int | None
+
+    def get(self, key: str, default=None):
+        return default
 
 
 def fix_declaration(data: bytes) -> tuple[bytes, list[tuple[int, str]]]:

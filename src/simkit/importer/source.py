@@ -14,6 +14,7 @@ from pathlib import Path
 
 from simkit.errors import SpecError
 from simkit.importer import lenient
+from simkit.importer.lenient import Position
 from simkit.importer.packages import MissingMesh, PackageMap
 from simkit.importer.reading import ReadOptions
 
@@ -21,17 +22,6 @@ __all__ = [
     "MissingMesh", "Position", "ReadOptions", "Source",
     "describe", "line_of", "load", "resolve_uri",
 ]  # fmt: skip
-
-
-@dataclass(frozen=True)
-class Position:
-    """A place in the file that is no element (an XML declaration): quacks like one."""
-
-    tag: str
-    sourceline: int | None
-
-    def get(self, key: str, default=None):
-        return default
 
 
 @dataclass

@@ -27,10 +27,10 @@ from xml.sax.saxutils import escape
 
 from simkit.errors import SpecError
 from simkit.importer import lenient
+from simkit.importer.lenient import Position
 from simkit.importer.packages import PackageMap
 from simkit.importer.reading import ReadOptions
 from simkit.importer.safe_eval import BUILTINS, MATH, Evaluator, Refused
-from simkit.importer.source import Position
 
 #: nested macro calls
 MAX_MACRO_DEPTH = 100
