@@ -195,3 +195,12 @@ def test_a_link_whose_only_mesh_is_missing_gets_an_estimated_box(tmp_path):
         if link["name"] == "arm"
     )
     assert arm["solid"][0]["shape"] == "box" and min(arm["solid"][0]["size"]) >= 0.01
+
+
+def test_substitutions_in_kept_gazebo_blocks_stay_verbatim(tmp_path):
+    text = _robot().replace(
+        "</robot>",
+        '  <gazebo><plugin name="$(arg ns)_control" filename="x.so"/></gazebo>\n</robot>',
+    )
+    done = import_robot(_urdf(tmp_path, text), tmp_path / "out")
+    assert "$(arg ns)_control" in done.spec_path.read_text()

@@ -120,15 +120,19 @@ def _parse(source: Source, text: bytes):
 
 
 def _expand_leftovers(source: Source, options: ReadOptions) -> None:
-    """`$(arg)`, `$(optenv)`, `$(env)` and `$(find)` left unexpanded in a .urdf: expanded to
-    the --xacro-arg value or the default (the environment only where --allow-env names it)."""
+    """`$(arg)`, `$(optenv)`, `$(env)` and `$(find)` left unexpanded in a .urdf's links and
+    joints: expanded to the --xacro-arg value or the default (the environment only where
+    --allow-env names it). Gazebo, transmission and ros2_control blocks stay verbatim."""
     defaults = {
         e.get("name"): e.get("default")
         for e in source.root.iter()
         if isinstance(e.tag, str) and e.tag.rpartition("}")[2] == "arg" and e.get("name")
     }
+    from simkit.spec.urdf_blocks import TAGS  # kept verbatim (importer/blocks.py)
+
     given = options.args()
-    for element in source.root.iter():
+    core = [e for e in source.root if isinstance(e.tag, str) and e.tag not in TAGS]
+    for element in (d for e in core for d in e.iter()):
         if not isinstance(element.tag, str):
             continue
         for key, value in element.attrib.items():
