@@ -123,19 +123,24 @@ def test_files_outside_the_package_are_refused_unless_allowed(tmp_path):
         ('  <link name="${1&lt;&lt;100000}"/>', "shift of 100000 bits is over the limit"),
         ("  <link name=\"${'a' * 10**8}\"/>", "repetition of 100000000 items is over the limit"),
         ('  <link name="${list(range(10**9))}"/>', "range of 1000000000 items is over the limit"),
+        ("  <link name=\"${''.join(['a' * 10**6] * 100)}\"/>", "join() of 100000000 characters"),
+        (
+            "  <link name=\"${('a' * 10**6).replace('a', 'bb')}\"/>",
+            "replace() of 2000000 characters",
+        ),
+        (
+            '  <link name="${[[0] * 10**6 for i in range(100)]}"/>',
+            "over the limit of 50000000 items",
+        ),
+        ('  <link name="${sum([[1]] * 10, [])}"/>', "sum() of non-numbers is not allowed"),
         ('  <link name="${' + "1+" * 6000 + '1}"/>', "characters is over the limit of 10000"),
         (
             '  <xacro:macro name="m" params="n"><xacro:m n="${n}"/><xacro:m n="${n}"/>'
             '</xacro:macro>\n  <xacro:m n="1"/>',
             "macro depth over the limit of 100",
         ),
-        (
-            '  <xacro:macro name="m" params="n"><xacro:if value="${n > 0}"><link name="x"/>'
-            '<xacro:m n="${n-1}"/><xacro:m n="${n-1}"/></xacro:if></xacro:macro>\n'
-            '  <xacro:m n="40"/>',
-            "over the limit of 20000 macro calls",
-        ),
     ],
+    ids=lambda value: value if len(value) < 40 else value[:37] + "...",
 )
 def test_expansion_is_bounded_with_one_line_naming_the_limit(tmp_path, body, limit):
     path = _xacro(tmp_path, body)
@@ -145,6 +150,19 @@ def test_expansion_is_bounded_with_one_line_naming_the_limit(tmp_path, body, lim
     assert limit in str(err.value) and "\n" not in str(err.value)
     assert str(err.value).startswith(f"{path}:3: ")
     assert time.perf_counter() - start < 30
+
+
+def test_macro_calls_are_bounded(tmp_path, monkeypatch):
+    """A macro expanding itself twice per level, 40 levels deep (2**40 calls): refused at
+    the call limit (lowered here to keep the test fast; the default is 20,000)."""
+    monkeypatch.setattr(xacro_safe, "MAX_MACRO_CALLS", 500)
+    body = (
+        '  <xacro:macro name="m" params="n"><xacro:if value="${n > 0}"><link name="x"/>'
+        '<xacro:m n="${n-1}"/><xacro:m n="${n-1}"/></xacro:if></xacro:macro>\n'
+        '  <xacro:m n="40"/>'
+    )
+    with pytest.raises(SpecError, match="over the limit of 500 macro calls in one expansion"):
+        _load(_xacro(tmp_path, body))
 
 
 def test_output_size_is_bounded(tmp_path, monkeypatch):

@@ -28,6 +28,8 @@ MAX_INT_BITS = 4096
 MAX_ITEMS = 1_000_000
 #: AST nodes of one expression
 MAX_NODES = 2_000
+#: items of all strings, lists and dicts made by the expressions of one expansion
+MAX_WORK = 50_000_000
 
 
 class Refused(Exception):
@@ -67,6 +69,13 @@ COMPARE: dict[type, Callable] = {
 FORMAT_WIDTH = re.compile(r"%[-#0 +]*(\*|\d+)?(?:\.(\*|\d+))?")
 
 
+def _numeric_sum(items, start=0):
+    """`sum` of numbers only (a list `start` would concatenate lists, quadratic in time)."""
+    if not isinstance(start, int | float):
+        raise Refused("sum() of non-numbers is not allowed in a safe xacro expression")
+    return sum(items, start)
+
+
 def _bounded_range(*args: int) -> range:
     out = range(*args)
     if len(out) > MAX_ITEMS:
@@ -78,7 +87,7 @@ def _bounded_range(*args: int) -> range:
 BUILTINS: dict[str, object] = {
     "list": list, "dict": dict, "tuple": tuple, "set": set, "frozenset": frozenset,
     "len": len, "str": str, "float": float, "int": int, "bool": bool, "min": min, "max": max,
-    "round": round, "abs": abs, "all": all, "any": any, "sum": sum, "sorted": sorted,
+    "round": round, "abs": abs, "all": all, "any": any, "sum": _numeric_sum, "sorted": sorted,
     "reversed": reversed, "enumerate": enumerate, "zip": zip, "map": map, "filter": filter,
     "divmod": divmod, "ord": ord, "chr": chr, "repr": repr, "range": _bounded_range,
     "True": True, "False": False, "None": None,
@@ -107,11 +116,23 @@ class Evaluator:
     (the identities of the functions it may call) and `namespaces` (types whose attributes
     are item lookups, e.g. xacro's NameSpace and its YAML dict wrapper)."""
 
-    def __init__(self, names: Mapping, callables: set[int], namespaces: tuple[type, ...]):
+    def __init__(
+        self, names: Mapping, callables: set[int], namespaces: tuple[type, ...], budget: list[int]
+    ):
         self.names = names
         self.callables = callables
         self.namespaces = namespaces
         self.scopes: list[dict] = []
+        self.budget = budget  # [items left], shared by the expressions of one expansion
+
+    def spend(self, value):
+        """`value` after its size is checked and taken from the expansion's budget."""
+        check_size(value)
+        if isinstance(value, str | bytes | list | tuple | dict | set) and len(value) > 1:
+            self.budget[0] -= len(value)
+            if self.budget[0] < 0:
+                raise Refused(f"expressions made over the limit of {MAX_WORK} items in all")
+        return value
 
     def run(self, text: str):
         if len(text) > MAX_EXPRESSION:
@@ -130,7 +151,7 @@ class Evaluator:
         method = getattr(self, f"do_{type(node).__name__}", None)
         if method is None:
             raise Refused(f"'{type(node).__name__}' is not allowed in a safe xacro expression")
-        return check_size(method(node))
+        return self.spend(method(node))
 
     def do_Constant(self, node):
         return node.value
@@ -235,6 +256,8 @@ class Evaluator:
             raise Refused(f"Python object access refused: call of '{ast.unparse(node.func)}'")
         args = [self.eval(a) for a in node.args]
         kwargs = {k.arg: self.eval(k.value) for k in node.keywords}
+        if bound is not None and isinstance(bound, str):
+            _check_string_call(bound, func.__name__, args)
         return func(*args, **kwargs)
 
     def _comprehension(self, node, make):
@@ -295,3 +318,20 @@ def _check_binary(op, left, right) -> None:
         for width in FORMAT_WIDTH.findall(left):
             if "*" in width or any(w and int(w) > 1000 for w in width):
                 raise Refused("a '%' format width over 1000 is not allowed")
+
+
+def _check_string_call(text: str, name: str, args: list) -> None:
+    """Refuse `join` and `replace` calls whose result would be over MAX_ITEMS, before
+    making it."""
+    size = 0
+    if name == "join" and args:
+        items = list(args[0]) if isinstance(args[0], list | tuple | str) else None
+        if items is None:
+            return
+        size = sum(len(i) for i in items if isinstance(i, str)) + len(text) * len(items)
+    elif name == "replace" and len(args) >= 2 and all(isinstance(a, str) for a in args[:2]):
+        old, new = args[0], args[1]
+        count = text.count(old) if old else len(text) + 1
+        size = len(text) + count * max(0, len(new) - len(old))
+    if size > MAX_ITEMS:
+        raise Refused(f"{name}() of {size} characters is over the limit of {MAX_ITEMS}")

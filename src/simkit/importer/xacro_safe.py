@@ -19,6 +19,7 @@ line (the first line of that file holding the expression or macro).
 
 from __future__ import annotations
 
+import io
 import os
 import threading
 from contextlib import contextmanager
@@ -30,7 +31,7 @@ from simkit.importer import lenient
 from simkit.importer.lenient import Position
 from simkit.importer.packages import PackageMap
 from simkit.importer.reading import ReadOptions
-from simkit.importer.safe_eval import BUILTINS, MATH, Evaluator, Refused
+from simkit.importer.safe_eval import BUILTINS, MATH, MAX_WORK, Evaluator, Refused
 
 #: nested macro calls
 MAX_MACRO_DEPTH = 100
@@ -94,6 +95,7 @@ class _Run:
         self.symbols = self._symbols()
         self.callables = {id(v) for v in self._callables()}
         self.namespaces = (xacro.Table, xacro.YamlDictWrapper)
+        self.budget = [MAX_WORK]
 
     # -- errors ------------------------------------------------------------------------
     def current(self) -> str:
@@ -177,7 +179,7 @@ class _Run:
     def _eval(self, expr, symbols, locals=None):
         text = str(expr)
         self.where = (self.current(), text.strip())
-        return Evaluator(symbols, self.callables, self.namespaces).run(text)
+        return Evaluator(symbols, self.callables, self.namespaces, self.budget).run(text)
 
     def _readable(self, path: Path, what: str) -> None:
         if self.options.trust_xacro or self.packages.allowed(path):
@@ -206,7 +208,7 @@ class _Run:
         data, notes = lenient.fix_declaration(data)
         for line, message in notes:
             self.source.lenient(Position("xml", line), f"{path.name}: {message}")
-        return self.original["parse"](data.decode("utf-8", "replace"), filename)
+        return self.original["parse"](io.BytesIO(data), filename)
 
     def _load_yaml(self, filename):
         path = Path(self.xacro.abs_filename_spec(str(filename)))
@@ -222,7 +224,7 @@ class _Run:
             return self.original["eval_extension"](text)
         if command == "eval":
             names = {**self.symbols, **self.xacro.substitution_args_context.get("arg", {})}
-            return str(Evaluator(names, self.callables, self.namespaces).run(rest))
+            return str(Evaluator(names, self.callables, self.namespaces, self.budget).run(rest))
         if command == "arg" and len(args) == 1:
             try:
                 return self.xacro.substitution_args_context["arg"][args[0]]
