@@ -148,9 +148,8 @@ class _Run:
     def _quiet(*args, **kwargs) -> str:
         return ""
 
-    @staticmethod
-    def _fatal(*args) -> None:
-        raise Refused("xacro.fatal: " + " ".join(map(str, args)))
+    def _fatal(self, *args) -> None:
+        raise self.xacro.XacroException("xacro.fatal: " + " ".join(map(str, args)))
 
     # -- hooks ---------------------------------------------------------------------------
     @contextmanager
