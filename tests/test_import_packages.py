@@ -124,3 +124,16 @@ def test_a_package_found_through_package_dir_may_lie_anywhere(tmp_path):
     )
     done = import_robot(urdf, tmp_path / "out", package_dirs=(tmp_path / "ws",))
     assert done.meshes == 1 and not any("not found as given" in x for x in done.lines)
+
+
+def test_a_package_uri_may_not_climb_out_of_its_package(tmp_path):
+    secret = _write(tmp_path / "secret.stl")
+    shared = tmp_path / "ws" / "parts_pkg"
+    _write(shared / "package.xml", "<package><name>parts_pkg</name></package>")
+    uri = "package://parts_pkg/../../secret.stl"
+    urdf = _write(tmp_path / "robot" / "urdf" / "r.urdf", _robot(uri))
+    with pytest.raises(SpecError, match=r"r\.urdf:6: mesh: .* climbs out of package 'parts_pkg'"):
+        import_robot(urdf, tmp_path / "out", package_dirs=(tmp_path / "ws",))
+    reading = ReadOptions(allow_read=(secret.parent,))
+    dirs = (tmp_path / "ws",)
+    assert import_robot(urdf, tmp_path / "out", package_dirs=dirs, reading=reading).meshes == 1

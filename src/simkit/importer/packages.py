@@ -136,6 +136,11 @@ class PackageMap:
             package, _, rest = uri[len("package://") :].lstrip("/").partition("/")
             base = self.find(package) if package else None
             if base is not None and (base / rest).is_file():
+                inside = _inside((base / rest).resolve(), base.resolve())
+                if not inside and not self.allowed(base / rest):
+                    raise SpecError(
+                        file, line, element, f"{uri} climbs out of package '{package}' ({base})"
+                    )
                 return base / rest
             missing = f"unknown package '{package}' in {uri}" if base is None else None
             parts = [package, *Path(rest).parts]
