@@ -193,3 +193,10 @@ def test_cli_refuses_an_evil_xacro_in_one_line(tmp_path):
     assert "Python object access refused" in result.output and "Traceback" not in result.output
     assert len(result.output.strip().splitlines()) == 1
     assert not marker.exists() and not (tmp_path / "out" / "r.yaml").exists()
+
+
+def test_malformed_xml_in_a_xacro_names_its_line(tmp_path):
+    path = _xacro(tmp_path, '  <link name="a">\n  </joint>')
+    with pytest.raises(SpecError) as err:
+        _load(path)
+    assert str(err.value).startswith(f"{path}:4: xacro: xacro expansion failed: mismatched tag")

@@ -71,8 +71,9 @@ def expand(path: Path, packages: PackageMap, options: ReadOptions, source) -> by
             if isinstance(inner, SpecError):
                 raise inner from None
             message = " ".join(str(exc).split()) or type(exc).__name__
+            line = getattr(exc, "lineno", None)  # expat's, for malformed XML
             raise SpecError(
-                run.current(), None, "xacro", f"xacro expansion failed: {message}"
+                run.current(), line, "xacro", f"xacro expansion failed: {message}"
             ) from None
     if len(text) > MAX_OUTPUT and not options.trust_xacro:
         raise SpecError(
