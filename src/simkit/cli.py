@@ -349,6 +349,20 @@ def publish(
 )
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path))
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
+@click.option(
+    "--xacro-arg", "xacro_args", multiple=True, help="NAME:=VALUE for $(arg NAME); repeatable."
+)
+@click.option(
+    "--allow-env", "allow_env", multiple=True, help="Env var $(env)/$(optenv) may read; repeatable."
+)
+@click.option(
+    "--allow-read",
+    "allow_read",
+    multiple=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder outside the robot's package that meshes and includes may read; repeatable.",
+)
+@click.option("--trust-xacro", is_flag=True, help="Run the xacro as is (trusted files only).")
 def import_urdf(
     path: Path,
     name: str | None,
@@ -358,13 +372,21 @@ def import_urdf(
     hull_collision: bool,
     out_dir: Path,
     quiet: bool,
+    xacro_args: tuple[str, ...],
+    allow_env: tuple[str, ...],
+    allow_read: tuple[Path, ...],
+    trust_xacro: bool,
 ) -> None:
     """Turn a URDF or xacro into OUT/NAME.yaml plus the meshes it needs."""
     from simkit.importer import import_robot
+    from simkit.importer.reading import ReadOptions, parse_xacro_arg
 
     try:
+        reading = ReadOptions(
+            tuple(parse_xacro_arg(a) for a in xacro_args), allow_env, allow_read, trust_xacro
+        )
         done = import_robot(
-            path, out_dir, name, package_dirs, strict, floating_base, hull_collision
+            path, out_dir, name, package_dirs, strict, floating_base, hull_collision, reading
         )
     except SimkitError as exc:
         _fail(exc)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from simkit.errors import SpecError
+from simkit.importer.reading import ReadOptions
 from simkit.importer.report import Report
 
 
@@ -146,17 +147,19 @@ def import_robot(
     strict: bool = False,
     floating: bool = False,
     hull_collision: bool = False,
+    reading: ReadOptions | None = None,
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `hull_collision`: links whose URDF collision has meshes collide with their visual
-    solid's convex hull instead (one piece; reported per link)."""
+    solid's convex hull instead (one piece; reported per link). `reading`: what the reader
+    may do (xacro args, environment, files outside the package; importer/reading.py)."""
     from simkit.importer import blocks, convert, meshes, names, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
-    doc = source.load(path, package_dirs)
     report = Report(strict=strict)
+    doc = source.load(path, package_dirs, report, reading)
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
         stage = Path(tmp)
