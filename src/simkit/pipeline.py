@@ -104,6 +104,7 @@ EMIT_LIBRARIES = (
     "usd-core",
     "jinja2",
     "cadquery-ocp",
+    "cadquery-ocp-novtk",
 )
 #: Libraries the simulate stage's figures depend on.
 SIMULATE_LIBRARIES = ("numpy", "scipy", "mujoco", "matplotlib")
