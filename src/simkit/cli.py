@@ -76,36 +76,59 @@ def build(
     no_step: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
+    for target in targets:
+        if not no_cache:  # a rebuild with nothing changed: one line, no heavy import
+            from simkit.kitio import noop
+
+            options = noop.options(usd_format, not no_step, not no_check)
+            line = noop.unchanged(target, out_dir, cache_dir, options)
+            if line:
+                out.print(line, markup=False)
+                continue
+        _build_one(target, out_dir, no_check, quiet, jobs, cache_dir, no_cache, usd_format, no_step)
+
+
+def _build_one(
+    target: str,
+    out_dir: Path,
+    no_check: bool,
+    quiet: bool,
+    jobs: int | None,
+    cache_dir: Path | None,
+    no_cache: bool,
+    usd_format: str,
+    no_step: bool,
+) -> None:
+    """The full build of one target (`simkit build`)."""
     from simkit.kitio.cache import Cache
     from simkit.pipeline import build as run_build
 
     cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
 
-    for target in targets:
+    def progress(msg: str, _t: str = target) -> None:
+        if not quiet:
+            err.print(f"[{_t}] {msg}", markup=False)
 
-        def progress(msg: str, _t: str = target) -> None:
-            if not quiet:
-                err.print(f"[{_t}] {msg}", markup=False)
-
-        try:
-            result = run_build(
-                target,
-                out_dir,
-                check=not no_check,
-                progress=None if quiet else progress,
-                cache=cache,
-                jobs=jobs,
-                usd_format=usd_format,
-                step=not no_step,
-            )
-        except SimkitError as exc:
-            _fail(exc)
-        passed = sum(f.ok for f in result.findings)
-        out.print(
-            f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed",
-            markup=False,
+    try:
+        result = run_build(
+            target,
+            out_dir,
+            check=not no_check,
+            progress=None if quiet else progress,
+            cache=cache,
+            jobs=jobs,
+            usd_format=usd_format,
+            step=not no_step,
         )
+    except SimkitError as exc:
+        _fail(exc)
+    passed = sum(f.ok for f in result.findings)
+    same = "" if result.changed else " (the same bytes as before: nothing rewritten)"
+    out.print(
+        f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
+        f"{result.zip_path}{same}; {passed}/{len(result.findings)} checks passed",
+        markup=False,
+    )
 
 
 @main.command()
@@ -119,6 +142,7 @@ def check(kit_dir: Path, verbose: bool) -> None:
     try:
         if not kit_dir.is_dir():
             raise SimkitError(f"{kit_dir}: no such kit folder")
+        _published_together(kit_dir)
         findings = run_checks(kit_dir)
     except SimkitError as exc:
         _fail(exc)
@@ -129,6 +153,17 @@ def check(kit_dir: Path, verbose: bool) -> None:
     out.print(f"{len(findings) - len(failed)} passed, {len(failed)} failed", markup=False)
     if failed:
         sys.exit(CheckFailed.exit_code)
+
+
+def _published_together(kit_dir: Path) -> None:
+    """A kit in a build folder: its zip and the manifest beside them agree (kitio/atomic.py),
+    else one line. Reads only."""
+    from simkit.errors import CheckFailed
+    from simkit.kitio.manifest import mismatch
+
+    line = mismatch(kit_dir)
+    if line:
+        raise CheckFailed(line)
 
 
 @main.command(name="list")
