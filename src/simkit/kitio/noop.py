@@ -69,10 +69,11 @@ def _tree_bytes(root: Path, pattern: str) -> list[bytes]:
     ]
 
 
-def code_digest() -> str:
-    """SHA-256 of simkit's version, modules and templates."""
+def code_digest(package: Path = _PACKAGE, templates: Path | None = None) -> str:
+    """SHA-256 of simkit's version, modules (under `package`) and templates."""
+    templates = data_dir("templates") if templates is None else templates
     h = hashlib.sha256(__version__.encode())
-    for part in (*_tree_bytes(_PACKAGE, "*.py"), *_tree_bytes(data_dir("templates"), "*")):
+    for part in (*_tree_bytes(package, "*.py"), *_tree_bytes(templates, "*")):
         h.update(len(part).to_bytes(8, "little"))
         h.update(part)
     return h.hexdigest()
