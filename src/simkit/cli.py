@@ -100,6 +100,10 @@ def _build_one(
     no_step: bool,
 ) -> None:
     """The full build of one target (`simkit build`)."""
+    import os
+
+    # a build renders nothing: MuJoCo then skips its OpenGL (glfw, cffi) imports
+    os.environ.setdefault("MUJOCO_GL", "disable")
     from simkit.kitio.cache import Cache
     from simkit.pipeline import build as run_build
 
