@@ -9,7 +9,8 @@ The record lists the files the spec names (meshes), and every published file (ki
 manifest) with its size, SHA-256 and `stat` identity. A rebuild with the same key is a no-op
 when every named file and every published file still matches: a file whose size, mtime,
 ctime and inode are unchanged is trusted (as git's index does), any other is hashed. Any
-difference, a missing record or `--no-cache` runs the full build. Standard library only.
+difference, a missing record or `--no-cache` runs the full build. The check holds a shared
+`flock` of `--out`, so it waits for a build into it to finish. Standard library only.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import sys
 from pathlib import Path
 
 from simkit import __version__
-from simkit.kitio import layout, manifest, reuse
+from simkit.kitio import atomic, layout, manifest, reuse
 from simkit.kitio.resources import data_dir
 
 FORMAT = 1
@@ -191,7 +192,25 @@ def unchanged(
         named, published, entries = doc["named"], doc["published"], doc["entries"]
     except (OSError, ValueError, KeyError, TypeError):
         return None
-    if doc.get("format") != FORMAT or (out_dir / manifest.journal_name(robot)).exists():
+    if doc.get("format") != FORMAT:
+        return None
+    fd = atomic.acquire(out_dir, shared=True)  # a build into out_dir finishes first
+    try:
+        return _verify(out_dir, robot, checks, named, published, entries)
+    finally:
+        atomic.release(fd)
+
+
+def _verify(
+    out_dir: Path,
+    robot: str,
+    checks: list[int] | None,
+    named: dict[str, list],
+    published: dict[str, list],
+    entries: list[str],
+) -> str | None:
+    """`unchanged` with the shared lock held."""
+    if (out_dir / manifest.journal_name(robot)).exists():
         return None
     kit, zip_path = out_dir / layout.kit_dir_name(robot), out_dir / layout.zip_name(robot)
     paths = _published(out_dir, robot)
