@@ -158,35 +158,38 @@ def remember(
 ) -> None:
     """Record a finished build (call after publishing; a cache that cannot be written only
     costs the next no-op)."""
-    digest = key(target, out_dir, options)
-    if digest is None:
-        return
-    doc = {
-        "format": FORMAT,
-        "robot": robot,
-        "named": {str(p.resolve()): _entry(p) for p in sorted(set(named)) if p.is_file()},
-        "published": {n: _entry(p) for n, p in sorted(_published(out_dir, robot).items())},
-        "entries": reuse.entries(out_dir / layout.kit_dir_name(robot)),
-        "checks": list(checks) if checks is not None else None,
-    }
-    path = _record_path(cache_dir, digest)
-    tmp = path.with_name(f".{secrets.token_hex(4)}.tmp")
+    tmp = None
     try:
+        digest = key(target, out_dir, options)
+        if digest is None:
+            return
+        kit = out_dir / layout.kit_dir_name(robot)
+        doc = {
+            "format": FORMAT,
+            "robot": robot,
+            "named": {str(p.resolve()): _entry(p) for p in sorted(set(named)) if p.is_file()},
+            "published": {n: _entry(p) for n, p in sorted(_published(out_dir, robot).items())},
+            "entries": reuse.entries(kit),
+            "checks": list(checks) if checks is not None else None,
+        }
+        path = _record_path(cache_dir, digest)
+        tmp = path.with_name(f".{secrets.token_hex(4)}.tmp")
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp.write_text(json.dumps(doc, sort_keys=True))
         os.replace(tmp, path)
     except OSError:
-        tmp.unlink(missing_ok=True)
+        if tmp is not None:
+            tmp.unlink(missing_ok=True)
 
 
 def unchanged(
     target: str, out_dir: Path, cache_dir: Path | None, options: dict[str, object]
 ) -> str | None:
     """The one line of a no-op rebuild, or None when the full build must run."""
-    digest = key(target, out_dir, options)
-    if digest is None or not out_dir.is_dir():
-        return None
     try:
+        digest = key(target, out_dir, options)
+        if digest is None or not out_dir.is_dir():
+            return None
         doc = json.loads(_record_path(cache_root(cache_dir), digest).read_bytes())
         robot, checks = doc["robot"], doc["checks"]
         named, published, entries = doc["named"], doc["published"], doc["entries"]
@@ -194,7 +197,10 @@ def unchanged(
         return None
     if doc.get("format") != FORMAT:
         return None
-    fd = atomic.acquire(out_dir, shared=True)  # a build into out_dir finishes first
+    try:
+        fd = atomic.acquire(out_dir, shared=True)  # a build into out_dir finishes first
+    except OSError:
+        return None
     try:
         return _verify(out_dir, robot, checks, named, published, entries)
     finally:
