@@ -15,6 +15,7 @@ difference, a missing record or `--no-cache` runs the full build. The check hold
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -179,7 +180,8 @@ def remember(
         os.replace(tmp, path)
     except OSError:
         if tmp is not None:
-            tmp.unlink(missing_ok=True)
+            with contextlib.suppress(OSError):
+                tmp.unlink()
 
 
 def unchanged(
