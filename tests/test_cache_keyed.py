@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simkit.kitio import confine
+from simkit.kitio import confine, reuse
 from simkit.kitio.cache import Cache, cached_stage, make_key
 from simkit.kitio.entry import DIGEST, KEY, TAG, content_digest
 
@@ -45,16 +45,16 @@ def test_unsafe_stored_paths_are_refused(rel):
 def test_write_tree_never_leaves_its_root(tmp_path):
     root = tmp_path / "kit"
     with pytest.raises(confine.UnsafePath):
-        confine.write_tree(root, {"ok.txt": b"1", "../escape.txt": b"2"})
+        reuse.write_tree(root, {"ok.txt": b"1", "../escape.txt": b"2"})
     assert not (tmp_path / "escape.txt").exists() and not (root / "ok.txt").exists()
     root.mkdir()
     (root / "link").symlink_to(tmp_path)  # a link inside the root pointing out of it
     with pytest.raises(confine.UnsafePath, match="symbolic link"):
-        confine.write_tree(root, {"link/escape.txt": b"2"})
+        reuse.write_tree(root, {"link/escape.txt": b"2"})
     with pytest.raises(confine.UnsafePath, match="both a file and a folder"):
-        confine.write_tree(root, {"a": b"1", "a/b": b"2"})
+        reuse.write_tree(root, {"a": b"1", "a/b": b"2"})
     assert not (tmp_path / "escape.txt").exists()
-    confine.write_tree(root, {"sub/ok.txt": b"1"})
+    reuse.write_tree(root, {"sub/ok.txt": b"1"})
     assert (root / "sub" / "ok.txt").read_bytes() == b"1"
 
 
@@ -171,7 +171,7 @@ def test_a_full_disk_while_staging_files_is_one_line_naming_the_file(tmp_path):
         "import resource, signal, sys\n"
         "from pathlib import Path\n"
         "from simkit.errors import SimkitError\n"
-        "from simkit.kitio.confine import write_tree\n"
+        "from simkit.kitio.reuse import write_tree\n"
         "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
         "resource.setrlimit(resource.RLIMIT_FSIZE, (65536, 65536))\n"
         "try:\n"

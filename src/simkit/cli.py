@@ -97,9 +97,6 @@ def build(
     on_ray: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
-    from simkit.kitio.cache import Stats
-    from simkit.pipeline import build as run_build
-
     if on_ray:
         options = {"check": not no_check, "usd_format": usd_format, "step": not no_step}
         # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)
@@ -111,39 +108,70 @@ def build(
         }
         _build_on_ray(targets, out_dir, quiet, options)
         return
-    cache = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
-
+    cache = None
     for target in targets:
-        cache.stats = Stats()  # each summary line counts its own robot's hits
+        if not no_cache:  # a rebuild with nothing changed: one line, no heavy import
+            from simkit.kitio import noop
 
-        def progress(msg: str, _t: str = target) -> None:
-            if not quiet:
-                err.print(f"[{_t}] {msg}", markup=False)
+            options = noop.options(usd_format, not no_step, not no_check)
+            line = noop.unchanged(target, out_dir, cache_dir, options)
+            if line:
+                out.print(line, markup=False)
+                continue
+        if cache is None:
+            cache = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
+        _build_one(target, out_dir, not no_check, quiet, jobs, cache, usd_format, not no_step)
 
-        try:
-            result = run_build(
-                target,
-                out_dir,
-                check=not no_check,
-                progress=None if quiet else progress,
-                cache=cache,
-                jobs=jobs,
-                usd_format=usd_format,
-                step=not no_step,
-            )
-        except SimkitError as exc:
-            _fail(exc)
-        for warning in result.warnings if not quiet else ():
-            err.print(f"warning: {warning}", markup=False)
-        hits = f"; cache local/remote/miss: {cache.stats.summary()}" if cache.enabled else ""
-        out.print(_built_line(result) + hits, markup=False)
+
+def _build_one(
+    target: str,
+    out_dir: Path,
+    check: bool,
+    quiet: bool,
+    jobs: int | None,
+    cache: Cache,
+    usd_format: str,
+    step: bool,
+) -> None:
+    """The full build of one target (`simkit build`), and its summary line."""
+    import os
+
+    from simkit.kitio.cache import Stats
+    from simkit.pipeline import build as run_build
+
+    # a build renders nothing: MuJoCo then skips its OpenGL (glfw, cffi) imports
+    os.environ.setdefault("MUJOCO_GL", "disable")
+    cache.stats = Stats()  # each summary line counts its own robot's hits
+
+    def progress(msg: str) -> None:
+        if not quiet:
+            err.print(f"[{target}] {msg}", markup=False)
+
+    try:
+        result = run_build(
+            target,
+            out_dir,
+            check=check,
+            progress=None if quiet else progress,
+            cache=cache,
+            jobs=jobs,
+            usd_format=usd_format,
+            step=step,
+        )
+    except SimkitError as exc:
+        _fail(exc)
+    for warning in result.warnings if not quiet else ():
+        err.print(f"warning: {warning}", markup=False)
+    hits = f"; cache local/remote/miss: {cache.stats.summary()}" if cache.enabled else ""
+    out.print(_built_line(result) + hits, markup=False)
 
 
 def _built_line(result) -> str:
     passed = sum(f.ok for f in result.findings)
+    same = "" if result.changed else " (the same bytes as before: nothing rewritten)"
     return (
         f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-        f"{result.zip_path}; {passed}/{len(result.findings)} checks passed"
+        f"{result.zip_path}{same}; {passed}/{len(result.findings)} checks passed"
     )
 
 
@@ -186,6 +214,7 @@ def check(kit_dir: Path, verbose: bool) -> None:
     try:
         if not kit_dir.is_dir():
             raise SimkitError(f"{kit_dir}: no such kit folder")
+        _published_together(kit_dir)
         findings = run_checks(kit_dir)
     except SimkitError as exc:
         _fail(exc)
@@ -196,6 +225,17 @@ def check(kit_dir: Path, verbose: bool) -> None:
     out.print(f"{len(findings) - len(failed)} passed, {len(failed)} failed", markup=False)
     if failed:
         sys.exit(CheckFailed.exit_code)
+
+
+def _published_together(kit_dir: Path) -> None:
+    """A kit in a build folder: its zip and the manifest beside them agree (kitio/atomic.py),
+    else one line. Reads only."""
+    from simkit.errors import CheckFailed
+    from simkit.kitio.manifest import mismatch
+
+    line = mismatch(kit_dir)
+    if line:
+        raise CheckFailed(line)
 
 
 @main.command(name="list")

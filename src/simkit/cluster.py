@@ -186,7 +186,7 @@ def run_job(job: Job, expected: str) -> Built:
             if "cache_args" in options:  # the worker's own cache (and its own secret)
                 options["cache"] = Cache.at(**options.pop("cache_args"))
             cache = options.setdefault("cache", Cache.at())
-            result = build(target, Path(tmp) / "out", **options)
+            result = build(target, Path(tmp) / "out", remember=False, **options)
             hits = cache.stats.summary() if cache.enabled else ""
             zip_bytes = result.zip_path.read_bytes()
             return Built(
@@ -245,7 +245,9 @@ def build_on_ray(
             error.exit_code = built.exit_code
             raise error
         say(f"[{built.robot}] built on Ray; publish")
-        kit_dir, zip_path = publish_files(out_dir, built.robot, built.files, built.zip_bytes)
+        kit_dir, zip_path, changed = publish_files(
+            out_dir, built.robot, built.files, built.zip_bytes
+        )
         results.append(
             RayBuildResult(
                 built.robot,
@@ -254,6 +256,7 @@ def build_on_ray(
                 built.files,
                 built.findings,
                 warnings=built.warnings,
+                changed=changed,
                 cache_hits=built.cache_hits,
             )
         )

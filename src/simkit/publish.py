@@ -12,6 +12,9 @@ The whole folder is built beside the output and swapped in at the end, so a fail
 leaves the previous publication in place. Publications into one folder serialize on a lock of
 its parent, and the swap is one `renameat2` exchange (`kitio.atomic.swap_folder`): a kill at
 any instant leaves the old site or the new one, and the next publish removes what it left.
+Files whose bytes did not change are hard links to the published ones (`kitio/reuse.py`), so
+they keep their mtime, and a publication equal to the published one writes nothing: an
+`rsync -a` to the server then sends only what changed.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from simkit.errors import SimkitError
-from simkit.kitio import atomic, layout
+from simkit.kitio import atomic, layout, reuse
 from simkit.kitio.jsonout import dumps
 from simkit.kitio.resources import robot_names
 from simkit.pipeline import build, find_spec, write_tree
@@ -97,8 +100,8 @@ def _publish_locked(
                     "another kit (set a distinct asset_dir in the spec)"
                 )
             zip_data = result.zip_path.read_bytes()
-            (site / result.zip_path.name).write_bytes(zip_data)
-            write_tree(site / folder, result.files)
+            reuse.write_file(site / result.zip_path.name, zip_data, out_dir / result.zip_path.name)
+            write_tree(site / folder, result.files, out_dir / folder)
             doc = json.loads(result.files[layout.ROBOT_JSON])
             kits.append(
                 {
@@ -118,8 +121,11 @@ def _publish_locked(
             "note": "paths are as in each zip; urls are relative to this file's folder",
             "kits": kits,
         }
-        (site / layout.INDEX_JSON).write_bytes(dumps(index))
-        atomic.swap_folder(site, out_dir)
+        reuse.write_file(site / layout.INDEX_JSON, dumps(index), out_dir / layout.INDEX_JSON)
+        if not reuse.same_tree(site, out_dir):  # else: the same publication, left untouched
+            if out_dir.is_dir():
+                reuse.keep_folder_times(site, out_dir)
+            atomic.swap_folder(site, out_dir)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return index
@@ -136,5 +142,5 @@ def _build_all(names: list[str], work: Path, say: Callable[[str], None], options
     results = []
     for target in names:
         say(f"build {target}")
-        results.append(build(target, work, check=True, progress=say, **options))
+        results.append(build(target, work, check=True, progress=say, remember=False, **options))
     return results

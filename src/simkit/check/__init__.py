@@ -102,6 +102,7 @@ CHECK_LIBRARIES = (
     "usd-core",
     "manifold3d",
     "cadquery-ocp",
+    "cadquery-ocp-novtk",
 )
 
 

@@ -4,13 +4,12 @@ results) stay inside their destination folder (issue 24, "Cache trust").
 A stored path is relative POSIX text: not empty, not absolute, no drive, no backslash or
 NUL, no empty, `.` or `..` part. Writing resolves every target and refuses one that leaves
 the destination or passes through a symbolic link, and never follows a link at the file
-itself (`O_NOFOLLOW`), so a forged entry cannot write outside `--out`.
+itself (kitio/reuse.py writes with O_EXCL), so a forged entry cannot write outside `--out`.
 """
 
 from __future__ import annotations
 
-import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from pathlib import Path
 
 from simkit.errors import SimkitError
@@ -55,21 +54,3 @@ def confined(root: Path, rel: str) -> Path:
     if not target.resolve().is_relative_to(base):
         raise UnsafePath(f"{rel!r}: resolves outside {root}")
     return target
-
-
-def write_tree(root: Path, files: Mapping[str, bytes]) -> None:
-    """Write `files` (relative POSIX paths) under `root`, each confined to it. A path that
-    would leave `root` is one line naming it; nothing is written outside `root`."""
-    check_tree(files)
-    for rel, data in files.items():
-        target = confined(root, rel)
-        try:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_NOFOLLOW", 0)
-            fd = os.open(target, flags, 0o666)
-            with os.fdopen(fd, "wb") as handle:
-                handle.write(data)
-        except OSError as exc:
-            if target.is_file() and not target.is_symlink():
-                target.unlink()  # no truncated file left behind
-            raise SimkitError(f"{target}: cannot write: {exc.strerror}") from None
