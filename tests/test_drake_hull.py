@@ -4,11 +4,13 @@ Links whose collision is the visual (`simkit import --hull`, a URDF without `<co
 floating base, a spec's `collision: mesh`) get that hull as one OBJ collision piece like any
 other link, so the URDF and SDF never point a collision at the visual STL (Drake's SceneGraph
 takes convex hulls only from OBJ, VTK or glTF). Small purpose-written inputs; one
-example-robot-data robot where installed.
+example-robot-data robot where installed. Drake (the `drake` wheel, a test extra) is needed by
+the slow tests only.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import site
 import sys
@@ -17,27 +19,30 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import trimesh
 
-pytest.importorskip("pydrake", reason="drake is not installed (pip install -e .[test])")
-trimesh = pytest.importorskip("trimesh")
+from simkit.check.readers.tree import read_urdf
+from simkit.importer import import_robot
+from simkit.kitio.cache import Cache
+from simkit.kitio.obj import from_obj
+from simkit.kitio.stl import from_stl
+from simkit.pipeline import build, model_from_spec
 
-from pydrake.geometry import Role  # noqa: E402
-from pydrake.multibody.parsing import Parser  # noqa: E402
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph  # noqa: E402
-from pydrake.systems.framework import DiagramBuilder  # noqa: E402
-
-from simkit.check.readers.tree import read_urdf  # noqa: E402
-from simkit.importer import import_robot  # noqa: E402
-from simkit.kitio.obj import from_obj  # noqa: E402
-from simkit.kitio.stl import from_stl  # noqa: E402
-from simkit.pipeline import build  # noqa: E402
-
-pytestmark = pytest.mark.slow
+#: the kit-building Drake tests are skipped where the test extra's drake is missing
+needs_drake = pytest.mark.skipif(
+    importlib.util.find_spec("pydrake") is None,
+    reason="drake is not installed (pip install -e .[test])",
+)
 
 
 def _proximity_geometries(kit: Path, fmt: str) -> tuple[int, int]:
     """(SceneGraph proximity geometries, `<collision>` elements) of the kit's URDF or SDF,
     loaded into a MultibodyPlant with SceneGraph (the fixed URDF root welded to the world)."""
+    from pydrake.geometry import Role
+    from pydrake.multibody.parsing import Parser
+    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+    from pydrake.systems.framework import DiagramBuilder
+
     doc = json.loads((kit / "robot.json").read_text())
     path = kit / fmt / f"{doc['name']}.{fmt}"
     builder = DiagramBuilder()
@@ -131,6 +136,8 @@ def _hull_urdf(tmp_path: Path) -> Path:
     return urdf
 
 
+@pytest.mark.slow
+@needs_drake
 def test_imported_with_hull_loads_in_drake(tmp_path):
     done = import_robot(_hull_urdf(tmp_path), tmp_path / "spec", hull_collision=True)
     text = done.spec_path.read_text()
@@ -176,6 +183,26 @@ joints:
 """
 
 
+def test_collision_mesh_link_gets_its_hull_as_one_piece(tmp_path):
+    """The derive step alone (fast): the `mesh` link's one piece is its solid's convex hull,
+    holding every vertex of the solid; the `convex` link keeps its exact piece."""
+    from scipy.spatial import ConvexHull
+
+    spec = tmp_path / "visual_hull.yaml"
+    spec.write_text(SPEC, encoding="utf-8")
+    robot = model_from_spec(str(spec), cache=Cache.disabled())
+    arm = robot.link("arm")
+    (piece,) = arm.collision
+    hull = ConvexHull(piece.vertices)
+    assert hull.volume == pytest.approx(ConvexHull(arm.solid.vertices).volume, rel=1e-9)
+    inside = arm.solid.vertices @ hull.equations[:, :3].T + hull.equations[:, 3]
+    assert inside.max() <= 1e-9
+    assert arm.collision_report["pieces"] == 1 and arm.collision_report["coverage"] == 1.0
+    assert len(robot.link("base_link").collision) == 1
+
+
+@pytest.mark.slow
+@needs_drake
 def test_spec_collision_mesh_loads_in_drake(tmp_path):
     """A spec link whose collision is its visual (`collision: mesh`), next to a `convex` one."""
     spec = tmp_path / "visual_hull.yaml"
@@ -197,6 +224,8 @@ def _corpus() -> Path | None:
     return None
 
 
+@pytest.mark.slow
+@needs_drake
 def test_example_robot_imported_with_hull_loads_in_drake(tmp_path):
     """A small example-robot-data arm whose URDF has collision meshes, imported with --hull."""
     corpus = _corpus()
