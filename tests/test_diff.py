@@ -11,7 +11,8 @@ import pytest
 from click.testing import CliRunner
 
 from simkit.cli import main
-from simkit.diff import diff_kits, to_markdown
+from simkit.diff import diff_kits
+from simkit.diff_text import to_markdown
 from simkit.kitio.stl import from_stl, to_stl
 
 
@@ -106,12 +107,13 @@ def test_each_kind_of_change(rosie_1000, copy):
         ("mesh", "meshes/visual/link_4.stl", "modified", "volume"),
         ("mesh", "meshes/visual/link_4.stl", "modified", "bbox"),
         ("collision", "link_1", "modified", "pieces"),
-        ("robot_json", "payload", "modified", ""),
+        ("robot_json", "payload", "modified", "rated"),
     }
     extra = keys - {k for k in keys if k[0] != "mesh" and k[0] != "collision"}
-    assert extra <= {
-        ("mesh", "meshes/visual/link_4.stl", "modified", f) for f in ("volume", "bbox")
-    } | {("collision", "link_1", "modified", "pieces")}
+    scaled = ("volume", "bbox", "displacement", "shape")  # scaled about the link origin
+    assert extra <= {("mesh", "meshes/visual/link_4.stl", "modified", f) for f in scaled} | {
+        ("collision", "link_1", "modified", "pieces")
+    }
     by_key = {_key(c): c for c in report.changes}
     volume = by_key[("mesh", "meshes/visual/link_4.stl", "modified", "volume")]
     assert volume.new / volume.old == pytest.approx(1.331, rel=1e-5) and volume.unit == "m^3"
