@@ -210,13 +210,18 @@ def write_report(
         out.parent.mkdir(parents=True, exist_ok=True)
         tmp.write_bytes(b"")
     except OSError as exc:
-        raise SimkitError(f"{out}: cannot write the report ({exc.strerror or exc})") from None
+        raise SimkitError(f"{out}: cannot write the report ({_why(exc)})") from None
     try:
         text = to_html(report, render_rows(old, new, report, size, progress))
         tmp.write_text(text, encoding="utf-8")
         tmp.replace(out)
     except OSError as exc:
-        raise SimkitError(f"{out}: cannot write the report ({exc.strerror or exc})") from None
+        raise SimkitError(f"{out}: cannot write the report ({_why(exc)})") from None
     finally:
         tmp.unlink(missing_ok=True)
     return out
+
+
+def _why(exc: OSError) -> str:
+    """The OS's reason, with the path it concerns: `NAME: File exists`."""
+    return f"{exc.filename}: {exc.strerror}" if exc.filename and exc.strerror else str(exc)
