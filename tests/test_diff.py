@@ -447,3 +447,11 @@ def test_unwritable_outputs_are_one_line(rosie_1000, tmp_path):
         assert result.exit_code == 2, result.output
         assert result.output.count("\n") == 1 and str(blocker) in result.output, result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
+
+
+def test_an_stl_with_nan_vertices_is_reported(rosie_1000, copy):
+    piece = sorted((copy / "meshes" / "collision").glob("*.stl"))[0]
+    _edit_stl(piece, lambda v: np.where(np.arange(len(v))[:, None] == 0, np.nan, v))
+    report = diff_kits(rosie_1000.kit_dir, copy)
+    change = next(c for c in report.changes if c.name.endswith(piece.name))
+    assert (change.field, change.old, change.new) == ("vertices", "finite", "non-finite")

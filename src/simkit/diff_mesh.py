@@ -72,6 +72,10 @@ def rigid_fit(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
 def mesh_changes(path: str, old: bytes, new: bytes) -> list[tuple]:
     """(field, old, new, unit) for every change of one mesh beyond the length rule."""
     a, b = piece(path, old), piece(path, new)
+    finite = [bool(np.all(np.isfinite(p.vertices))) for p in (a, b)]
+    if not all(finite):  # a hostile or damaged file: say so, compare nothing
+        state = ["finite" if f else "non-finite" for f in finite]
+        return [("vertices", *state, "")] if finite[0] or old != new else []
     out: list[tuple] = []
     # the same triangles in the same order (an edited or moved piece): compare corner by corner
     corners = len(a.faces) == len(b.faces) and len(a.faces) > 0

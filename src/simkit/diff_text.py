@@ -20,6 +20,8 @@ TITLES = {
     "step": "STEP solids (assembly frame, mm)",
     "robot_json": "Other robot.json entries",
 }
+#: numbers of one value listed in a cell
+MAX_LISTED = 9
 #: the short Markdown's table rows; the rest are counted and left to the full report
 SHORT_ROWS = 40
 
@@ -51,7 +53,9 @@ def value_text(value, unit: str, field_name: str) -> str:
             text += f" ({number(degrees, 5)} deg{unit[3:]})" if math.isfinite(degrees) else ""
         return text
     if isinstance(value, list) and all(_is_num(v) for v in value):
-        return f"({', '.join(number(v) for v in value)}) {unit}".rstrip()
+        shown = [number(v) for v in value[:MAX_LISTED]]
+        more = f", ... {len(value) - MAX_LISTED} more" if len(value) > MAX_LISTED else ""
+        return f"({', '.join(shown)}{more}) {unit}".rstrip()
     text = json.dumps(value, sort_keys=True, default=str)
     return text if len(text) <= 80 else text[:77] + "..."
 
@@ -76,7 +80,7 @@ def delta_text(change: Change) -> str:
         rel = f", {number(100 * step / a, 3)} %" if a and math.isfinite(100 * step / a) else ""
         return f"{'+' if step >= 0 else ''}{number(step)} {change.unit}".rstrip() + rel
     numeric = isinstance(a, list) and isinstance(b, list) and len(a) == len(b)
-    if numeric and all(_is_num(v) for v in a + b):
+    if numeric and len(a) <= MAX_LISTED and all(_is_num(v) for v in a + b):
         steps = [y - x for x, y in zip(a, b, strict=True)]
         if all(math.isfinite(v) for v in steps):
             return f"({', '.join(number(v) for v in steps)}) {change.unit}".rstrip()
