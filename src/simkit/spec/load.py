@@ -37,7 +37,9 @@ class SourceDoc:
 MAX_DEPTH = 48
 MAX_NODES = 200_000
 MAX_BYTES = 4_000_000
-MAX_INT_DIGITS = 20  # every integer a spec takes (seed < 2**32, counts) has at most 10 digits
+#: a longer integer overflows float() (the bounds check would raise); shorter ones get the
+#: bounds' own message ("at most ...")
+MAX_INT_DIGITS = 308
 _TAGS = {
     f"tag:yaml.org,2002:{name}"
     for name in ("str", "int", "float", "bool", "null", "map", "seq", "timestamp")
@@ -94,7 +96,8 @@ def _walk(
         return [_walk(child, (*loc, i), lines, stack, count) for i, child in enumerate(node.value)]
     digits = sum(c.isdigit() for c in str(node.value)) if node.tag.endswith(":int") else 0
     if digits > MAX_INT_DIGITS:
-        raise _refuse(node, loc, f"an integer of {digits} digits is beyond any value a spec takes")
+        why = f"an integer of {digits} digits (at most {MAX_INT_DIGITS}) is beyond any number"
+        raise _refuse(node, loc, why)
     try:
         return _CONSTRUCTOR.construct_object(node, deep=True)
     except (yaml.YAMLError, ValueError, OverflowError) as exc:
