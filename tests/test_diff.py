@@ -455,3 +455,23 @@ def test_an_stl_with_nan_vertices_is_reported(rosie_1000, copy):
     report = diff_kits(rosie_1000.kit_dir, copy)
     change = next(c for c in report.changes if c.name.endswith(piece.name))
     assert (change.field, change.old, change.new) == ("vertices", "finite", "non-finite")
+
+
+def test_any_other_joint_or_link_value_is_reported(rosie_1000, copy):
+    """A joint's drive or a link's estimate list is no listed field, but a change all the
+    same; the `*_deg` twins of a changed angle are not reported twice."""
+
+    def change(doc):
+        doc["joints"][0]["drive"]["motor_peak_torque"] = 4.0
+        doc["joints"][0]["lower"] = -4.0
+        doc["joints"][0]["lower_deg"] = -229.18
+        doc["links"][1]["estimated"] = ["mass"]
+
+    _edit_json(copy, change)
+    report = diff_kits(rosie_1000.kit_dir, copy)
+    assert sorted(_key(c) for c in report.changes) == [
+        ("joint", "J1", "modified", "drive.motor_peak_torque"),
+        ("joint", "J1", "modified", "lower"),
+        ("link", "link_1", "modified", "estimated"),
+    ]
+    assert report.changed == ["robot.json"] and not report.equal

@@ -187,12 +187,27 @@ def _entities(
     out = [Change(kind, name, "removed") for name in old if name not in new]
     out += [Change(kind, name, "added") for name in new if name not in old]
     for name in (n for n in new if n in old):
+        a, b = old[name], new[name]
         for key, unit in fields.items():
-            if old[name].get("type") == "prismatic" and key in ("lower", "upper"):
+            if a.get("type") == "prismatic" and key in ("lower", "upper"):
                 unit = "m"
-            a, b = _flat(old[name].get(key)), _flat(new[name].get(key))
-            if not same(a, b, tolerance(unit)):
-                out.append(Change(kind, name, "modified", key, a, b, unit))
+            x, y = _flat(a.get(key)), _flat(b.get(key))
+            if not same(x, y, tolerance(unit)):
+                out.append(Change(kind, name, "modified", key, x, y, unit))
+        out += _other_fields(kind, name, a, b, fields)
+    return out
+
+
+def _other_fields(kind: str, name: str, a: dict, b: dict, fields: dict) -> list[Change]:
+    """Fields of a joint or link beyond `fields` (drive, derived values, estimates), each
+    changed value with its path; a `*_deg*` twin follows its radians and is skipped."""
+    keys = [k for k in [*a, *(k for k in b if k not in a)] if k not in fields and k != "name"]
+    keys = [k for k in keys if not ("_deg" in k and k.split("_deg")[0] in {*a, *b})]
+    leaves = [leaf for k in keys for leaf in leaf_changes(a.get(k), b.get(k), PARAM_SI, k)]
+    out = [Change(kind, name, "modified", path, x, y) for path, x, y in leaves[:MAX_LEAVES]]
+    if len(leaves) > MAX_LEAVES:
+        more = f"{len(leaves) - MAX_LEAVES} more values"
+        out.append(Change(kind, name, "modified", "...", "-", more))
     return out
 
 
