@@ -12,14 +12,15 @@ import pytest
 
 
 @pytest.mark.slow
-def test_a_build_writes_nothing_under_home_but_the_cache(tmp_path):
+@pytest.mark.parametrize("flags", [[], ["--no-cache"]], ids=["cache", "no_cache"])
+def test_a_build_writes_nothing_under_home_but_the_cache(tmp_path, flags):
     home, cache, tmp, out = (tmp_path / n for n in ("home", "cache", "tmp", "out"))
     home.mkdir()
     tmp.mkdir()
     env = {k: v for k, v in os.environ.items() if not k.startswith(("XDG_", "MPL"))}
     env.update(HOME=str(home), SIMKIT_CACHE_DIR=str(cache), TMPDIR=str(tmp))
     result = subprocess.run(
-        [sys.executable, "-m", "simkit.cli", "build", "ecn_2r", "--out", str(out), "-q"],
+        [sys.executable, "-m", "simkit.cli", "build", "ecn_2r", "--out", str(out), "-q", *flags],
         capture_output=True,
         text=True,
         env=env,
@@ -29,4 +30,7 @@ def test_a_build_writes_nothing_under_home_but_the_cache(tmp_path):
     assert (out / "ecn_2r_description" / "validation" / "freefall.png").is_file()
     assert sorted(p.relative_to(home).as_posix() for p in home.rglob("*")) == []
     assert sorted(p.name for p in tmp.iterdir()) == []
-    assert (cache / "matplotlib").is_dir()  # matplotlib's font list lives in simkit's cache
+    if flags:  # no cache: nothing at all outside --out
+        assert not cache.exists()
+    else:  # matplotlib's font list lives in simkit's cache
+        assert (cache / "matplotlib").is_dir()

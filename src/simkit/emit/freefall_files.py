@@ -81,17 +81,20 @@ def plot_png(robot: Robot, data: dict) -> bytes:
 @contextlib.contextmanager
 def matplotlib_home() -> Iterator[None]:
     """Import matplotlib with MPLCONFIGDIR in simkit's cache folder (`matplotlib/`: its font
-    list), or else in a temporary folder removed afterwards: by default it writes
+    list) where that folder exists, else in a temporary folder removed afterwards (about
+    0.5 s to rebuild the font list): by default it writes
     ~/.config/matplotlib and ~/.cache/matplotlib, and a build writes nothing outside --out
     but simkit's cache. A user's own MPLCONFIGDIR, or matplotlib already imported, is kept."""
     if "MPLCONFIGDIR" in os.environ or "matplotlib" in sys.modules:
         yield
         return
     scratch = None
-    try:
+    try:  # never create the cache folder for this alone (--no-cache, --cache-dir elsewhere)
         home = default_dir() / "matplotlib"
-        home.mkdir(parents=True, exist_ok=True)
-    except OSError:  # an unwritable cache folder
+        if not home.parent.is_dir():
+            raise FileNotFoundError(home.parent)
+        home.mkdir(exist_ok=True)
+    except OSError:  # no cache folder, or an unwritable one
         home = scratch = Path(tempfile.mkdtemp(prefix="simkit-matplotlib-"))
     os.environ["MPLCONFIGDIR"] = str(home)
     try:
