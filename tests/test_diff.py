@@ -234,6 +234,7 @@ def test_a_length_changed_by_1e_9_m_prints_no_change(tmp_path):
     report = diff_kits(old.kit_dir, new.kit_dir)
     assert report.equal and not report.identical, report.changes
     assert report.changes == [] and report.changed == [] and report.round_off
+    assert report.metadata == ["provenance.spec_sha256"]
     result = CliRunner().invoke(main, ["diff", str(old.kit_dir), str(new.kit_dir)])
     assert result.exit_code == 0, result.output
     assert "No changes beyond the checks' tolerances" in result.output

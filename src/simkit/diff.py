@@ -54,7 +54,6 @@ COVERED_KEYS = {"joints", "fixed_joints", "links"}
 METADATA_KEYS = ("provenance",)
 #: changed values listed per other robot.json key; the rest are counted
 MAX_LEAVES = 8
-ANGLE_FIELDS = {"lower", "upper", "max_velocity", "origin_rpy", "springref"}
 COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.stl$")
 
 
@@ -301,7 +300,7 @@ def diff_files(
             )
     report.changes += _other_entries(a, b)
     for key in METADATA_KEYS:
-        report.metadata += [p for p, _x, _y in leaf_changes(a.get(key), b.get(key), 0.0)]
+        report.metadata += [p for p, _x, _y in leaf_changes(a.get(key), b.get(key), 0.0, key)]
     for path in differ:
         kind = _round_off(path, old[path], new[path], report.changes)
         (report.round_off if kind else report.changed).append(path)
