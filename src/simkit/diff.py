@@ -309,4 +309,8 @@ def diff_files(
 
 def diff_kits(old: Path, new: Path) -> Report:
     """Compare two kit folders or zips."""
-    return diff_files(load_kit(old), load_kit(new), str(old), str(new))
+    files = load_kit(old), load_kit(new)
+    try:
+        return diff_files(*files, str(old), str(new))
+    except RecursionError:  # a robot.json that json reads but is too deep to compare
+        raise SimkitError(f"{new}: {layout.ROBOT_JSON} is nested too deeply to compare") from None
