@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import tempfile
 import zipfile
 from pathlib import Path
 
@@ -358,9 +359,11 @@ def test_html_tables_have_no_empty_columns(rosie_1000, copy):
 
 @pytest.mark.slow
 def test_check_accepts_a_zip(rosie_1000):
-    result = CliRunner().invoke(main, ["check", str(rosie_1000.zip_path)])
+    """Every check of the folder, the zip's own (its entries against the kit) included."""
+    result = CliRunner().invoke(main, ["check", "-v", str(rosie_1000.zip_path)])
     assert result.exit_code == 0, result.output
-    assert result.output.strip().endswith("0 failed")
+    assert result.output.strip().endswith(f"{len(rosie_1000.findings)} passed, 0 failed")
+    assert "ok   generated.zip" in result.output
 
 
 def test_check_refuses_a_hostile_zip_in_one_line(rosie_1000, tmp_path):
@@ -375,6 +378,14 @@ def test_check_refuses_a_hostile_zip_in_one_line(rosie_1000, tmp_path):
     with zipfile.ZipFile(leaving, "w") as archive:
         archive.writestr("kit/robot.json", doc)
         archive.writestr("kit/../../evil.txt", b"x")
+    escape = f"simkit_escape_{tmp_path.name}"
+    named = tmp_path / "named.zip"
+    with zipfile.ZipFile(named, "w") as archive:
+        doc = {"name": f"../{escape}", "joints": [], "fixed_joints": [], "links": []}
+        archive.writestr("kit/robot.json", json.dumps(doc))
+    result = CliRunner().invoke(main, ["check", str(named)])
+    assert "Traceback" not in result.output and result.exit_code in (2, 3), result.output
+    assert not list(Path(tempfile.gettempdir()).glob(f"{escape}*"))
     for path, message in ((clash, "cannot be extracted"), (leaving, "leaves the kit")):
         result = CliRunner().invoke(main, ["check", str(path)])
         assert result.exit_code == 2, result.output

@@ -116,7 +116,7 @@ def check(kit_dir: Path, verbose: bool) -> None:
     import tempfile
 
     from simkit.check import run_checks
-    from simkit.diff import load_kit, materialize
+    from simkit.diff import load_kit, unpacked
     from simkit.errors import CheckFailed
 
     try:
@@ -125,7 +125,7 @@ def check(kit_dir: Path, verbose: bool) -> None:
         elif kit_dir.is_file():  # a zip: read with kitread's caps, written as plain files
             files = load_kit(kit_dir)
             with tempfile.TemporaryDirectory(prefix="simkit-check-") as tmp:
-                findings = run_checks(materialize(files, Path(tmp) / "kit"))
+                findings = run_checks(unpacked(kit_dir, files, Path(tmp)))
         else:
             raise SimkitError(f"{kit_dir}: no such kit folder or zip")
     except SimkitError as exc:

@@ -165,6 +165,19 @@ def materialize(files: dict[str, bytes], dest: Path) -> Path:
     return dest
 
 
+def unpacked(zip_path: Path, files: dict[str, bytes], tmp: Path) -> Path:
+    """A kit zip as a build lays it out, under the empty folder `tmp`: the files under
+    `NAME_description/` and the zip itself beside them, so the checks that compare the two
+    run as on a build (`simkit check KIT.zip`). A robot name unfit for a folder name (any
+    character beyond [A-Za-z0-9_]) unpacks as `kit/`, without the zip."""
+    name = str(json.loads(files[layout.ROBOT_JSON]).get("name", ""))
+    if not re.fullmatch(r"[A-Za-z0-9_]{1,100}", name):
+        return materialize(files, tmp / "kit")
+    kit = materialize(files, tmp / layout.kit_dir_name(name))
+    (tmp / layout.zip_name(name)).write_bytes(zip_path.read_bytes())
+    return kit
+
+
 def _robot_json(files: dict[str, bytes]) -> dict:
     data = files.get(layout.ROBOT_JSON)
     return json.loads(data) if data else {}
