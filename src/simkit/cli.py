@@ -207,15 +207,23 @@ def _open_cache(dir_: str | None, off: bool, readonly: bool, remote: str | None)
 @click.argument("kit_dir", type=click.Path(path_type=Path))
 @click.option("-v", "--verbose", is_flag=True, help="Print every finding, not only failures.")
 def check(kit_dir: Path, verbose: bool) -> None:
-    """Run the checks on a built kit folder."""
+    """Run the checks on a built kit (folder or zip)."""
+    import tempfile
+
     from simkit.check import run_checks
+    from simkit.diff import load_kit, unpacked
     from simkit.errors import CheckFailed
 
     try:
-        if not kit_dir.is_dir():
-            raise SimkitError(f"{kit_dir}: no such kit folder")
-        _published_together(kit_dir)
-        findings = run_checks(kit_dir)
+        if kit_dir.is_dir():
+            _published_together(kit_dir)
+            findings = run_checks(kit_dir)
+        elif kit_dir.is_file():  # a zip: read with kitread's caps, written as plain files
+            files = load_kit(kit_dir)
+            with tempfile.TemporaryDirectory(prefix="simkit-check-") as tmp:
+                findings = run_checks(unpacked(kit_dir, files, Path(tmp)))
+        else:
+            raise SimkitError(f"{kit_dir}: no such kit folder or zip")
     except SimkitError as exc:
         _fail(exc)
     failed = [f for f in findings if not f.ok]
@@ -258,9 +266,18 @@ def list_robots() -> None:
     default=None,
     help="Also write a self-contained HTML report with renders of every named pose.",
 )
-def diff(old: Path, new: Path, as_json: bool, html_out: Path | None) -> None:
-    """Report what changed between two kits (folders or zips); exit 0 equal, 1 different."""
-    from simkit.diff import diff_kits, to_markdown
+@click.option(
+    "--markdown",
+    "md_out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also write a short Markdown summary (GitHub job summary, PR comment); appends.",
+)
+def diff(old: Path, new: Path, as_json: bool, html_out: Path | None, md_out: Path | None) -> None:
+    """Report what changed between two kits (folders or zips) beyond the checks' tolerances;
+    exit 0 equal, 1 different."""
+    from simkit.diff import diff_kits
+    from simkit.diff_text import to_markdown, to_short_markdown
 
     try:
         report = diff_kits(old, new)
@@ -268,10 +285,26 @@ def diff(old: Path, new: Path, as_json: bool, html_out: Path | None) -> None:
             from simkit.review.commands import diff_html
 
             diff_html(report, old, new, html_out, _say)
+        if md_out is not None:
+            full = (
+                f"Full report with renders: `{html_out}`."
+                if html_out is not None
+                else "Full report: `simkit diff OLD NEW --html REPORT.html`."
+            )
+            _append(md_out, to_short_markdown(report, full))
     except SimkitError as exc:
         _fail(exc)
     click.echo(report.to_json() if as_json else to_markdown(report), nl=False)
     sys.exit(0 if report.equal else 1)
+
+
+def _append(path: Path, text: str) -> None:
+    """Append `text` to `path` (GitHub's job summary file is shared by the job's steps)."""
+    try:
+        with open(path, "a", encoding="utf-8") as handle:
+            handle.write(text)
+    except OSError as exc:
+        raise SimkitError(f"{path}: cannot write ({exc.strerror or exc})") from None
 
 
 def _say(msg: str) -> None:
