@@ -123,7 +123,8 @@ def test_changed_code_templates_or_libraries_change_the_key(built, tmp_path, mon
     assert _unchanged(built) is not None
     site = tmp_path / "site"
     (site / "somelib-1.0.dist-info").mkdir(parents=True)
-    monkeypatch.syspath_prepend(str(site))
+    # a folder on the start-up path (PYTHONPATH, site-packages) as the next process sees it
+    monkeypatch.setattr(noop, "_IMPORT_PATH", (str(site), *noop._IMPORT_PATH))
     assert _unchanged(built) is None
     os.rename(site / "somelib-1.0.dist-info", site / "somelib-1.1.dist-info")
     assert _unchanged(built) is None

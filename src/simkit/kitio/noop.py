@@ -81,11 +81,17 @@ def code_digest(package: Path = _PACKAGE, templates: Path | None = None) -> str:
     return h.hexdigest()
 
 
+#: `sys.path` as this module first saw it: a library imported later may add folders (Ray
+#: adds its `thirdparty_files`), and the key written after a build must equal the key the
+#: next `simkit build` computes before importing anything.
+_IMPORT_PATH = tuple(sys.path)
+
+
 def environment() -> list[str]:
     """Python's version and every installed distribution with its version (the names of
-    the `*.dist-info` / `*.egg-info` entries on `sys.path`)."""
+    the `*.dist-info` / `*.egg-info` entries on `sys.path` as it was at start-up)."""
     found = {sys.version}
-    for entry in sys.path:
+    for entry in _IMPORT_PATH:
         try:
             names = os.listdir(entry or ".")
         except OSError:
