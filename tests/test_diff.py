@@ -15,6 +15,7 @@ from click.testing import CliRunner
 from simkit.cli import main
 from simkit.diff import diff_kits
 from simkit.diff_text import to_markdown
+from simkit.kitio.obj import read_mesh, to_obj
 from simkit.kitio.stl import from_stl, to_stl
 
 
@@ -258,19 +259,21 @@ def test_a_primitive_moved_50_mm_is_reported_with_its_displacement(kit_factory, 
     assert not report.equal
 
 
-def _edit_stl(path, change) -> None:
-    mesh = from_stl(path.read_bytes())
-    path.write_bytes(to_stl(mesh._replace(vertices=change(mesh.vertices)), path.stem))
+def _edit_mesh(path, change) -> None:
+    """Edit a kit mesh's vertices: a visual STL or a collision OBJ, rewritten as such."""
+    mesh = read_mesh(path.name, path.read_bytes())
+    write = to_obj if path.suffix == ".obj" else to_stl
+    path.write_bytes(write(mesh._replace(vertices=change(mesh.vertices)), path.stem))
 
 
 def test_collision_pieces_moved_and_turned_are_reported(rosie_1000, copy):
     """A piece moved 50 mm and another turned 10 deg about its centre (same size: the old
     comparison of bounding-box sizes saw neither the move nor, for a round piece, the turn)."""
-    pieces = sorted((copy / "meshes" / "collision").glob("*.stl"))
-    _edit_stl(pieces[0], lambda v: np.add(v, [0.05, 0.0, 0.0]))
+    pieces = sorted((copy / "meshes" / "collision").glob("*.obj"))
+    _edit_mesh(pieces[0], lambda v: np.add(v, [0.05, 0.0, 0.0]))
     turn = np.radians(10)
     rot = np.array([[1, 0, 0], [0, np.cos(turn), -np.sin(turn)], [0, np.sin(turn), np.cos(turn)]])
-    _edit_stl(pieces[1], lambda v: (v - v.mean(axis=0)) @ rot.T + v.mean(axis=0))
+    _edit_mesh(pieces[1], lambda v: (v - v.mean(axis=0)) @ rot.T + v.mean(axis=0))
     report = diff_kits(rosie_1000.kit_dir, copy)
     by_key = {(c.name, c.field): c for c in report.changes}
     first, second = (p.relative_to(copy).as_posix() for p in pieces[:2])
@@ -461,9 +464,13 @@ def test_unwritable_outputs_are_one_line(rosie_1000, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file"]
 
 
-def test_an_stl_with_nan_vertices_is_reported(rosie_1000, copy):
-    piece = sorted((copy / "meshes" / "collision").glob("*.stl"))[0]
-    _edit_stl(piece, lambda v: np.where(np.arange(len(v))[:, None] == 0, np.nan, v))
+def test_a_mesh_with_nan_vertices_is_reported(rosie_1000, copy):
+    piece = sorted((copy / "meshes" / "collision").glob("*.obj"))[0]
+    # a hand-edited (or corrupted) OBJ: the first vertex's x is `nan`
+    text = piece.read_text().splitlines()
+    first = next(i for i, line in enumerate(text) if line.startswith("v "))
+    text[first] = "v nan " + " ".join(text[first].split()[2:])
+    piece.write_text("\n".join(text) + "\n")
     report = diff_kits(rosie_1000.kit_dir, copy)
     change = next(c for c in report.changes if c.name.endswith(piece.name))
     assert (change.field, change.old, change.new) == ("vertices", "finite", "non-finite")

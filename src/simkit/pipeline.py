@@ -238,7 +238,7 @@ def build(
         import numpy as np
 
         cache.put("built", hint, {"built": np.ones(1, dtype=np.uint8)})
-    if remember and cache.enabled and cache.root is not None:
+    if remember and cache.enabled and not cache.readonly and cache.root is not None:
         passed = sum(f.ok for f in result.findings)
         counts = (passed, len(result.findings)) if check else None
         options = noop.options(usd_format, step, check)
