@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from simkit.importer.ball_joints import expand as expand_ball_joints
 from simkit.importer.geometry import floats
 from simkit.importer.joints import joint_spec, mimic_limits
 from simkit.importer.links import has_geometry, has_mass, link_spec
@@ -117,6 +118,7 @@ def convert(
             report.dropped(
                 source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
             )
+    expand_ball_joints(source)  # spherical joints: three revolute ones (ball_joints.py)
     links, by_child, root = _tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)
