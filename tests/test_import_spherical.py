@@ -114,6 +114,13 @@ def test_strict_refuses_a_ball_in_one_line(tmp_path):
     assert not list((tmp_path / "out").glob("*.yaml"))  # nothing half-written
 
 
+def test_ball_naming_a_missing_link_is_one_line(tmp_path):
+    path = _urdf(tmp_path, LIMITED)
+    path.write_text(path.read_text().replace('<child link="arm"/>', '<child link="nope"/>'))
+    with pytest.raises(SpecError, match=r"ball.urdf:13: joint\[shoulder\]: unknown child link"):
+        import_robot(path, tmp_path / "out")
+
+
 def _pybullet_link_frame(urdf: Path, quat_xyzw) -> tuple[np.ndarray, np.ndarray]:
     """World position and rotation matrix of `arm`'s URDF frame in PyBullet with the ball
     joint at `quat_xyzw` (PyBullet reads the spherical joint itself: the reference)."""

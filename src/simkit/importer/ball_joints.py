@@ -65,6 +65,9 @@ def _expand_one(source: Source, joint, links: set, joints: set) -> None:
     parent, child = joint.find("parent"), joint.find("child")
     if parent is None or child is None or not parent.get("link") or not child.get("link"):
         raise source.fail(joint, "a joint needs <parent link=...> and <child link=...>")
+    for end in (parent, child):
+        if end.get("link") not in links:
+            raise source.fail(joint, f"unknown {end.tag} link '{end.get('link')}'")
     ranges = _ranges(source, joint)
     names = [_free(f"{name}{suffix}", joints) if suffix else name for suffix, _, _ in AXES]
     bodies = [_free(f"{n}_link", links) for n in names[:2]]
