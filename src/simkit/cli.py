@@ -111,7 +111,13 @@ def build(
 @main.command()
 @click.argument("kit_dir", type=click.Path(path_type=Path))
 @click.option("-v", "--verbose", is_flag=True, help="Print every finding, not only failures.")
-def check(kit_dir: Path, verbose: bool) -> None:
+@click.option(
+    "--source",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also compare the kit with the URDF it was imported from (kinematics, limits, mass).",
+)
+def check(kit_dir: Path, verbose: bool, source: Path | None) -> None:
     """Run the checks on a built kit folder."""
     from simkit.check import run_checks
     from simkit.errors import CheckFailed
@@ -119,7 +125,9 @@ def check(kit_dir: Path, verbose: bool) -> None:
     try:
         if not kit_dir.is_dir():
             raise SimkitError(f"{kit_dir}: no such kit folder")
-        findings = run_checks(kit_dir)
+        if source is not None and not source.is_file():
+            raise SimkitError(f"{source}: no such source file")
+        findings = run_checks(kit_dir, source=source)
     except SimkitError as exc:
         _fail(exc)
     failed = [f for f in findings if not f.ok]

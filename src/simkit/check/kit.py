@@ -18,9 +18,11 @@ class Kit:
     """A kit folder on disk."""
 
     root: Path
+    #: the URDF the kit was imported from (check/source.py compares them), when given
+    source: Path | None = None
 
     @staticmethod
-    def open(path: Path) -> Kit:
+    def open(path: Path, source: Path | None = None) -> Kit:
         from simkit.kitio.kitread import read_folder_safely, robot_json_problem
 
         if not (path / "robot.json").is_file():
@@ -31,7 +33,7 @@ class Kit:
         why = robot_json_problem((path / "robot.json").read_bytes())
         if why:
             raise SimkitError(f"{path}: robot.json {why}")
-        return Kit(path)
+        return Kit(path, source)
 
     def path(self, relative: str) -> Path:
         return self.root / relative

@@ -218,4 +218,6 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         ros2_control=spec.ros2_control,
         urdf_blocks=spec.urdf_blocks,
         freefall=spec.freefall,
+        source=None if spec.source is None else (spec.source.file, spec.source.sha256),
+        source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
     )

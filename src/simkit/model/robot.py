@@ -275,6 +275,10 @@ class Robot:
     #: URDF elements carried over verbatim (spec `urdf_blocks`: an import's gazebo,
     #: transmission and ros2_control blocks), as XML text
     urdf_blocks: tuple[str, ...] = ()
+    #: an import's kept source: (file name beside the spec, SHA-256), or None
+    source: tuple[str, str] | None = None
+    #: the kit's intended differences from that source: (what, reason, kit name or None)
+    source_differences: tuple[tuple[str, str, str | None], ...] = ()
 
     def link(self, name: str) -> Link:
         for link in self.links:

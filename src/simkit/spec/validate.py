@@ -298,11 +298,17 @@ def _mesh_files(spec: RobotSpec, base_dir: Path) -> Iterator[Problem]:
                 yield ("links", i, "solid", k, "file"), f"mesh file not found: {prim.file}"
 
 
+def _source_file(spec: RobotSpec, base_dir: Path) -> Iterator[Problem]:
+    """An imported spec's kept source (`source.file`, beside the spec) exists."""
+    if spec.source is not None and not (base_dir / spec.source.file).is_file():
+        yield ("source", "file"), f"source file not found: {spec.source.file}"
+
+
 def load_spec(path: Path, display: str | None = None) -> tuple[RobotSpec, SourceDoc]:
     """Read and validate one spec file."""
     doc = load_yaml(path, display)
     spec = validate(doc)
-    problems = list(_mesh_files(spec, path.parent))
+    problems = list(_mesh_files(spec, path.parent)) + list(_source_file(spec, path.parent))
     if problems:
         raise _first(problems, doc)
     return spec, doc
