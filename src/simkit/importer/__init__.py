@@ -150,7 +150,7 @@ def import_robot(
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `hull_collision`: links whose URDF collision has meshes collide with their visual
     solid's convex hull instead (one piece; reported per link)."""
-    from simkit.importer import blocks, convert, meshes, names, provenance, source, writer
+    from simkit.importer import blocks, convert, located, meshes, names, provenance, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
@@ -172,13 +172,14 @@ def import_robot(
         _step_budget(spec, stage, report, doc)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
+        located.check(stage / f"{name}.yaml", spec, doc, renames)  # before the pose fix-ups
         if floating:  # stance.py: out of self-contact with the feet kept, then stand
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
         else:  # home.py: out of self-contact, any joint between touching links may move
             _free_home(spec, report, doc, stage / f"{name}.yaml", path)
         _narrow_limits(spec, report, doc, stage / f"{name}.yaml", path)
         provenance.record(spec, doc, report, renames, stage / f"{name}.yaml", path)
-        writer.check(stage / f"{name}.yaml")
+        located.check(stage / f"{name}.yaml", spec, doc, renames)
         for item in sorted(stage.rglob("*")):
             if item.is_file():
                 target = out_dir / item.relative_to(stage)

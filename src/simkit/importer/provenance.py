@@ -75,7 +75,7 @@ def differences(
         key = "joints" if kind == "joints" else "links"
         for old, new in sorted(table.items()):
             add(f"{key}.{old}.name", f"renamed: '{old}' is not a name the kit can hold", new)
-    _added(spec, source, add)
+    _added(spec, source, back, add)
     _frames(spec, source, back, add)
     for kind, fields in COMPARED.items():
         tag = kind[:-1]
@@ -93,13 +93,14 @@ def differences(
     return [out[k] for k in sorted(out)]
 
 
-def _added(spec: dict, source: Source, add) -> None:
-    """A fixed base bolts the URDF's root link to a `world` link the URDF does not have."""
-    if spec["root"] != "world" or source.root.find("link[@name='world']") is not None:
-        return
+def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
+    """A fixed base bolts the URDF's root link to a root frame (`world`) the URDF lacks."""
+    root = spec["root"]
+    if source.root.find(f"link[@name='{_quoted(back.get(root, root))}']") is not None:
+        return  # the URDF's own massless root link is the kit's root
     for joint in spec["joints"]:
-        if joint["parent"] == "world" and joint["type"] == "fixed":
-            add("links.world", "added: the world the fixed base is bolted to")
+        if joint["parent"] == root and joint["type"] == "fixed":
+            add(f"links.{root}", "added: the world the fixed base is bolted to")
             add(f"joints.{joint['name']}", "added: bolts the URDF's root link to the world")
 
 
