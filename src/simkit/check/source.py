@@ -19,6 +19,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.kitio.oneline import one_line
 
 #: relative tolerance: the kit carries 10 significant digits (kitio/fmt.py); a hand-typed
 #: source rarely more. Far below any real change (an axis turned, a mass 10 % off).
@@ -108,8 +109,8 @@ def compare_robots(source, built, allowed: _Allowed) -> list[Finding]:
     for link in source.links:
         name = _kit_name(allowed.links, link.name, links)
         if name not in links:
-            if f"links.{link.name}" not in allowed.keys:
-                link_problems.append(f"link '{link.name}' is missing from the kit")
+            if f"links.{one_line(link.name)}" not in allowed.keys:
+                link_problems.append(f"link '{one_line(link.name)}' is missing from the kit")
             continue
         seen_links.add(name)
         link_problems += _mass(link, links[name], allowed)
@@ -117,8 +118,8 @@ def compare_robots(source, built, allowed: _Allowed) -> list[Finding]:
     for joint in source.joints:
         name = _kit_name(allowed.joints, joint.name, joints)
         if name not in joints:
-            if f"joints.{joint.name}" not in allowed.keys:
-                joint_problems.append(f"joint '{joint.name}' is missing from the kit")
+            if f"joints.{one_line(joint.name)}" not in allowed.keys:
+                joint_problems.append(f"joint '{one_line(joint.name)}' is missing from the kit")
             continue
         seen_joints.add(name)
         joint_problems += _joint(joint, joints[name], allowed)
@@ -150,7 +151,7 @@ def compare_robots(source, built, allowed: _Allowed) -> list[Finding]:
 
 def _kit_name(renames: dict[str, str], name: str, kit: dict) -> str:
     """The kit's name of source element `name`: as listed renamed, else its own."""
-    new = renames.get(name, name)
+    new = renames.get(one_line(name), name)
     return new if new in kit or name not in kit else name
 
 
@@ -181,20 +182,20 @@ def _mass_properties(link) -> tuple[float, np.ndarray, np.ndarray]:
 
 def _mass(src, kit, allowed: _Allowed) -> list[str]:
     """Mass, CoM and inertia of one link, each unless listed."""
-    key = f"links.{src.name}"
+    key, shown = f"links.{one_line(src.name)}", one_line(src.name)
     m0, c0, i0 = _mass_properties(src)
     m1, c1, i1 = _mass_properties(kit)
     out = []
     if f"{key}.mass" not in allowed.keys and not _close(m0, m1, abs(m0), 0.0):
-        out.append(f"link '{src.name}': mass {m0:.9g} kg in the source, {m1:.9g} in the kit")
+        out.append(f"link '{shown}': mass {m0:.9g} kg in the source, {m1:.9g} in the kit")
     if f"{key}.com" not in allowed.keys and not _close(
         c0, c1, float(np.max(np.abs(c0))), ABS_LENGTH
     ):
-        out.append(f"link '{src.name}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
+        out.append(f"link '{shown}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
     scale = float(np.max(np.abs(i0)))
     if f"{key}.inertia" not in allowed.keys and not _close(i0, i1, scale, 0.0):
         out.append(
-            f"link '{src.name}': inertia (link axes) {_v(np.diag(i0))} kg m^2 on the diagonal "
+            f"link '{shown}': inertia (link axes) {_v(np.diag(i0))} kg m^2 on the diagonal "
             f"in the source, {_v(np.diag(i1))} in the kit"
         )
     return out
@@ -202,7 +203,7 @@ def _mass(src, kit, allowed: _Allowed) -> list[str]:
 
 def _joint(src, kit, allowed: _Allowed) -> list[str]:
     """Type, parent, child, origin, axis and limits of one joint, each unless listed."""
-    key, name = f"joints.{src.name}", f"joint '{src.name}'"
+    key, name = f"joints.{one_line(src.name)}", f"joint '{one_line(src.name)}'"
     out = []
 
     def differs(attr: str, a, b) -> None:
@@ -212,7 +213,7 @@ def _joint(src, kit, allowed: _Allowed) -> list[str]:
     if src.type != kit.type:
         differs("type", src.type, kit.type)
     for end in ("parent", "child"):
-        want = allowed.links.get(getattr(src, end), getattr(src, end))
+        want = allowed.links.get(one_line(getattr(src, end)), getattr(src, end))
         if want != getattr(kit, end):
             differs(end, getattr(src, end), getattr(kit, end))
     o0 = np.eye(4) if src.origin is None else np.asarray(src.origin, dtype=float)

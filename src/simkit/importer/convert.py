@@ -12,6 +12,7 @@ from simkit.importer.links import has_geometry, has_mass, link_spec
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
 from simkit.importer.source import Source
+from simkit.kitio.oneline import one_line
 from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 
 TOP = ("link", "joint", "material")
@@ -171,9 +172,9 @@ def convert(
         report.changed(source, links[root], "massless root of a floating base")
     spec: dict = {
         "name": name,
-        "title": source.root.get("name") or name,
-        "description": f"Imported from {source.path.name} by simkit import.",
-        "sources": [source.path.name],
+        "title": one_line(source.root.get("name") or name),
+        "description": f"Imported from {one_line(source.path.name)} by simkit import.",
+        "sources": [one_line(source.path.name)],
         "root": spec_root,
     }
     if floating:

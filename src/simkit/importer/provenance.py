@@ -16,6 +16,7 @@ from pathlib import Path
 
 from simkit.importer.report import Report
 from simkit.importer.source import Source, line_of
+from simkit.kitio.oneline import one_line
 
 #: spec fields of a link or joint the source check compares, as its `estimated` names them
 COMPARED = {
@@ -69,6 +70,7 @@ def differences(
     out: dict[str, dict] = {}
 
     def add(what: str, reason: str, kit: str | None = None) -> None:
+        what, reason = one_line(what), one_line(reason)  # URDF names may hold a newline
         out.setdefault(what, {"what": what, "reason": reason, **({"kit": kit} if kit else {})})
 
     for kind, table in sorted(renames.items()):
