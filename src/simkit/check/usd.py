@@ -101,6 +101,27 @@ def _mass_findings(stage, mj, links: dict[str, str]) -> list[Finding]:
     ]
 
 
+def _moving(kit: Kit) -> set[str]:
+    """Links a movable or floating joint moves, directly or through the links above them
+    (robot.json's joints, fixed joints and floating base)."""
+    above = {j["child"]: (j["parent"], True) for j in kit.joints}
+    above.update({j["child"]: (j["parent"], False) for j in kit.doc.get("fixed_joints", [])})
+    floating = kit.doc.get("floating_base")
+    if floating:
+        above[floating["child"]] = (floating["parent"], True)
+    out: set[str] = set()
+    for link in above:
+        node, seen = link, set()
+        while node in above and node not in seen:
+            seen.add(node)
+            parent, moves = above[node]
+            if moves:
+                out.add(link)
+                break
+            node = parent
+    return out
+
+
 def _mj_local(mj, body: int) -> np.ndarray:
     """T_parent_body of an MJCF body (its pos/quat)."""
     out, rot = np.eye(4), np.zeros(9)
@@ -361,15 +382,19 @@ def check_usd(kit: Kit) -> list[Finding]:
     if parsed is not None:
         joints = joints_from_parser(parsed)
         arts = parsed.get(UsdPhysics.ObjectType.Articulation, ([], []))[1]
-        bodies = {str(b) for a in arts for b in a.articulatedBodies}
-        # one rigid body and no joint (a quadrotor's frame) articulates nothing: the parser
-        # lists no articulation, or one without bodies; usd.bodies checked its rigid body
-        alone = len(links) == 1 and not kit.joints and not kit.doc.get("fixed_joints")
+        held = {str(b) for a in arts for b in a.articulatedBodies}
+        moved = {str(p) for a in arts for p in a.articulatedJoints}
+        held |= {b for j in joints if j.path in moved for b in (j.body0, j.body1)}
+        # the parser may leave out a body whose only joint is the articulated one from the
+        # world (a hinged cube); bodies welded to the world (a fixed-base quadrotor's frame
+        # and props) move with nothing, so they need no articulation
+        need = {links[n] for n in _moving(kit) if n in links}
         findings.append(
             require(
                 "usd.articulation",
-                (len(arts) == 1 and set(links.values()) <= bodies) or (alone and len(arts) <= 1),
-                f"UsdPhysics parser: {len(arts)} articulation(s) holding every link",
+                (len(arts) == 1 and need <= held) or (not need and len(arts) <= 1),
+                f"UsdPhysics parser: {len(arts)} articulation(s) holding every link a joint "
+                f"moves ({len(need)} of {len(links)})",
             )
         )
     else:
