@@ -31,7 +31,7 @@ SHOWN = 20
 
 
 @dataclass
-class _Allowed:
+class Allowed:
     """robot.json's `source_differences`: allowed keys and the source -> kit renames."""
 
     keys: set[str] = field(default_factory=set)
@@ -39,8 +39,9 @@ class _Allowed:
     joints: dict[str, str] = field(default_factory=dict)
 
     @staticmethod
-    def of(doc: dict) -> _Allowed:
-        out = _Allowed()
+    def of(doc: dict) -> Allowed:
+        """From robot.json (or any dict with `source_differences`)."""
+        out = Allowed()
         for item in doc.get("source_differences", []):
             what = str(item.get("what", ""))
             out.keys.add(what)
@@ -51,7 +52,8 @@ class _Allowed:
         return out
 
 
-def _load(path: Path):
+def load_urdf(path: Path):
+    """The URDF's robot as yourdfpy reads it (no meshes loaded: kinematics and inertials)."""
     import logging
 
     import yourdfpy  # lazy: pulls in trimesh
@@ -69,16 +71,16 @@ def check_source(kit: Kit) -> list[Finding]:
         return []
     findings = _digest(kit, kit.source)
     try:
-        source = _load(kit.source)
+        source = load_urdf(kit.source)
     except Exception as exc:  # yourdfpy raises several types on bad input
         why = " ".join(str(exc).split())[:200]
         return [*findings, require("source.read", False, f"yourdfpy cannot read the source: {why}")]
     try:
-        built = _load(kit.path(kit.urdf))
+        built = load_urdf(kit.path(kit.urdf))
     except Exception as exc:
         why = " ".join(str(exc).split())[:200]
         return [*findings, require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
-    return findings + compare_robots(source, built, _Allowed.of(kit.doc))
+    return findings + compare_robots(source, built, Allowed.of(kit.doc))
 
 
 def _digest(kit: Kit, path: Path) -> list[Finding]:
@@ -99,7 +101,7 @@ def _digest(kit: Kit, path: Path) -> list[Finding]:
     ]
 
 
-def compare_robots(source, built, allowed: _Allowed) -> list[Finding]:
+def compare_robots(source, built, allowed: Allowed) -> list[Finding]:
     """Findings for yourdfpy robots `source` and `built` (the kit's URDF)."""
     out: list[Finding] = []
     links = {link.name: link for link in built.links}
@@ -180,7 +182,7 @@ def _mass_properties(link) -> tuple[float, np.ndarray, np.ndarray]:
     return float(inertial.mass or 0.0), origin[:3, 3].copy(), rot @ tensor @ rot.T
 
 
-def _mass(src, kit, allowed: _Allowed) -> list[str]:
+def _mass(src, kit, allowed: Allowed) -> list[str]:
     """Mass, CoM and inertia of one link, each unless listed."""
     key, shown = f"links.{one_line(src.name)}", one_line(src.name)
     m0, c0, i0 = _mass_properties(src)
@@ -201,7 +203,7 @@ def _mass(src, kit, allowed: _Allowed) -> list[str]:
     return out
 
 
-def _joint(src, kit, allowed: _Allowed) -> list[str]:
+def _joint(src, kit, allowed: Allowed) -> list[str]:
     """Type, parent, child, origin, axis and limits of one joint, each unless listed."""
     key, name = f"joints.{one_line(src.name)}", f"joint '{one_line(src.name)}'"
     out = []
@@ -231,7 +233,7 @@ def _joint(src, kit, allowed: _Allowed) -> list[str]:
     return out
 
 
-def _limits(src, kit, allowed: _Allowed, key: str, name: str) -> list[str]:
+def _limits(src, kit, allowed: Allowed, key: str, name: str) -> list[str]:
     """lower/upper (not for continuous), velocity and effort: URDF's <limit>."""
     out = []
     fields = [("max_velocity", "velocity"), ("effort_peak", "effort")]
