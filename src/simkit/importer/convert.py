@@ -13,6 +13,7 @@ from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
 from simkit.importer.source import Source
 from simkit.kitio.oneline import one_line
+from simkit.spec.bounds import MAX_BODIES
 from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 
 TOP = ("link", "joint", "material")
@@ -30,6 +31,10 @@ def _tree(source: Source) -> tuple[dict, dict, str]:
         links[name] = link
     if not links:
         raise source.fail(source.root, "no <link> in the robot")
+    if len(links) > MAX_BODIES:  # refused before any per-link work (a 10,000-link chain)
+        raise source.fail(
+            source.root, f"{len(links)} links: a spec holds at most {MAX_BODIES} (spec/bounds.py)"
+        )
     by_child: dict = {}
     joint_names: set = set()
     for joint in source.root.findall("joint"):
