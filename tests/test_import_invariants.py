@@ -68,6 +68,8 @@ def test_a_primitive_below_a_millimetre_is_left_out_with_a_report_line(tmp_path)
     arm = spec["links"][1]
     assert "solid" not in arm and arm["collision_primitives"] == []
     assert "collision sphere of 0.0005 m is below the 0.001 m a spec simulates" in lines
+    whats = {d["what"] for d in spec["source_differences"]}
+    assert {"links.arm.visual", "links.arm.collision"} <= whats  # listed for the record
 
 
 def test_a_spec_refusal_names_the_urdf_line_not_the_staging_copy(tmp_path):

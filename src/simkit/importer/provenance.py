@@ -88,6 +88,8 @@ def differences(
             for field in item.get("estimated", []):
                 if field in fields:
                     add(f"{kind}.{old}.{field}", said or GENERIC[field])
+            if kind == "links" and element is not None:
+                _dropped(report, source, element, f"links.{old}", add)
             if kind == "links" and item.get("inertia_decision"):
                 add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
             if kind == "joints" and element is not None and element.get("type") != item["type"]:
@@ -118,6 +120,20 @@ def _frames(spec: dict, source: Source, back: dict[str, str], add) -> None:
                 if joint.get("name") != kit:
                     reason = "the massless leaf link is a kit frame, its joint named FRAME_joint"
                     add(f"joints.{joint.get('name')}.name", reason, kit)
+
+
+def _dropped(report: Report, source: Source, link, key: str, add) -> None:
+    """A visual or collision element the import left out (unreadable mesh, a primitive below
+    a millimetre, ...): listed for the record (the check compares no geometry)."""
+    for tag in ("visual", "collision"):
+        said = [
+            m.split(": ", 1)[-1]
+            for part in link.findall(tag)
+            for m in _said(report, source, part).split("; ")
+            if m.startswith(f"not imported: {tag} ")
+        ]
+        if said:
+            add(f"{key}.{tag}", "left out: " + "; ".join(said[:4]))
 
 
 def _said(report: Report, source: Source, element) -> str:
