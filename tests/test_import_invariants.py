@@ -122,23 +122,38 @@ def test_an_inertia_on_the_limit_is_raised_off_it_and_mujoco_compiles_it(tmp_pat
     assert "links.arm.inertia" in whats  # the source check allows it, with the reason
 
 
+def _props() -> list[str]:
+    """A quadrotor: a frame and four props on fixed joints."""
+    disc = '<geometry><cylinder radius="0.1" length="0.01"/></geometry>'
+    out = [_link("frame")]
+    for k, (x, y) in enumerate([(0.2, 0), (-0.2, 0), (0, 0.2), (0, -0.2)]):
+        out.append(_link(f"prop{k}", "1e-5 1e-5 1e-5", disc))
+        out.append(
+            f'<joint name="prop{k}_joint" type="fixed"><parent link="frame"/>'
+            f'<child link="prop{k}"/><origin xyz="{x} {y} 0.05"/></joint>'
+        )
+    return out
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    "body",
+    ("body", "floating"),
     [
         # a cube hinged on a massless `world` root: the parser leaves the cube out of the
         # articulation's bodies though its joint is articulated
-        ['<link name="world"/>', _link("cube"), _joint("world", "cube", "hinge")],
+        (['<link name="world"/>', _link("cube"), _joint("world", "cube", "hinge")], False),
         # one body fixed to the world (a quadrotor's frame with the default fixed base)
-        [_link("frame")],
+        ([_link("frame")], False),
+        # a floating quadrotor with fixed-only props: rigid, nothing to articulate
+        (_props(), True),
     ],
-    ids=["hinged_cube", "fixed_quadrotor_frame"],
+    ids=["hinged_cube", "fixed_quadrotor_frame", "floating_quadrotor_props"],
 )
-def test_usd_articulation_passes_legitimate_small_imports(tmp_path, body):
+def test_usd_articulation_passes_legitimate_small_imports(tmp_path, body, floating):
     from simkit.pipeline import build
 
     urdf = tmp_path / "p.urdf"
     urdf.write_text('<?xml version="1.0"?>\n<robot name="p">\n' + "\n".join(body) + "\n</robot>\n")
-    done = import_robot(urdf, tmp_path / "out")
+    done = import_robot(urdf, tmp_path / "out", floating=floating)
     result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
     assert any(f.check == "usd.articulation" and f.ok for f in result.findings)

@@ -62,6 +62,24 @@ class Kit:
     def base_frame(self) -> str:
         return self.doc["base_frame"]
 
+    def moved_links(self) -> set[str]:
+        """Links a movable joint moves, directly or through the links above them (robot.json's
+        joints and fixed joints). A floating base alone moves nothing relative to the rest: a
+        rigid robot, floating or fixed (a quadrotor and its props), has none."""
+        above = {j["child"]: (j["parent"], True) for j in self.joints}
+        above.update({j["child"]: (j["parent"], False) for j in self.doc.get("fixed_joints", [])})
+        out: set[str] = set()
+        for link in above:
+            node, seen = link, set()
+            while node in above and node not in seen:
+                seen.add(node)
+                parent, moves = above[node]
+                if moves:
+                    out.add(link)
+                    break
+                node = parent
+        return out
+
     def fk(self, q, target: str | None = None) -> np.ndarray:
         """T_base_target from robot.json's joints (movable and fixed) and frames."""
         target = target or self.doc["tool_frame"]

@@ -101,27 +101,6 @@ def _mass_findings(stage, mj, links: dict[str, str]) -> list[Finding]:
     ]
 
 
-def _moving(kit: Kit) -> set[str]:
-    """Links a movable or floating joint moves, directly or through the links above them
-    (robot.json's joints, fixed joints and floating base)."""
-    above = {j["child"]: (j["parent"], True) for j in kit.joints}
-    above.update({j["child"]: (j["parent"], False) for j in kit.doc.get("fixed_joints", [])})
-    floating = kit.doc.get("floating_base")
-    if floating:
-        above[floating["child"]] = (floating["parent"], True)
-    out: set[str] = set()
-    for link in above:
-        node, seen = link, set()
-        while node in above and node not in seen:
-            seen.add(node)
-            parent, moves = above[node]
-            if moves:
-                out.add(link)
-                break
-            node = parent
-    return out
-
-
 def _mj_local(mj, body: int) -> np.ndarray:
     """T_parent_body of an MJCF body (its pos/quat)."""
     out, rot = np.eye(4), np.zeros(9)
@@ -386,9 +365,9 @@ def check_usd(kit: Kit) -> list[Finding]:
         moved = {str(p) for a in arts for p in a.articulatedJoints}
         held |= {b for j in joints if j.path in moved for b in (j.body0, j.body1)}
         # the parser may leave out a body whose only joint is the articulated one from the
-        # world (a hinged cube); bodies welded to the world (a fixed-base quadrotor's frame
-        # and props) move with nothing, so they need no articulation
-        need = {links[n] for n in _moving(kit) if n in links}
+        # world (a hinged cube); a rigid robot (a quadrotor's frame and props, fixed or
+        # floating) has no joint to articulate
+        need = {links[n] for n in kit.moved_links() if n in links}
         findings.append(
             require(
                 "usd.articulation",
