@@ -17,6 +17,7 @@ from pathlib import Path
 from simkit.importer.report import Report
 from simkit.importer.source import Source, line_of
 from simkit.kitio.oneline import one_line
+from simkit.spec.bounds import MAX_STRING
 
 #: spec fields of a link or joint the source check compares, as its `estimated` names them
 COMPARED = {
@@ -71,6 +72,8 @@ def differences(
 
     def add(what: str, reason: str, kit: str | None = None) -> None:
         what, reason = one_line(what), one_line(reason)  # URDF names may hold a newline
+        if len(reason) > MAX_STRING:  # a one-line URDF: every report line matches its line
+            reason = reason[: MAX_STRING - 3] + "..."
         out.setdefault(what, {"what": what, "reason": reason, **({"kit": kit} if kit else {})})
 
     for kind, table in sorted(renames.items()):
