@@ -15,7 +15,7 @@ import hashlib
 from pathlib import Path
 
 from simkit.importer.report import Report
-from simkit.importer.source import Source, line_of
+from simkit.importer.source import Source, describe, line_of
 from simkit.kitio.oneline import one_line
 from simkit.spec.bounds import MAX_STRING
 
@@ -140,14 +140,14 @@ def _dropped(report: Report, source: Source, link, key: str, add) -> None:
 
 
 def _said(report: Report, source: Source, element) -> str:
-    """The report's messages about `element` or anything inside it (its line numbers)."""
+    """The report's messages about `element` or an element inside it (each report line
+    starts `FILE:LINE: ELEMENT: `, so a URDF on one line still tells a link from a joint)."""
     if element is None:
         return ""
-    lines = {line_of(e) for e in element.iter() if line_of(e)}
-    prefixes = tuple(f"{source.path.name}:{n}:" for n in sorted(lines))
-    said = [
-        line.split(": ", 2)[-1] for line in report.lines if prefixes and line.startswith(prefixes)
-    ]
+    prefixes = tuple(
+        sorted({f"{source.path.name}:{line_of(e)}: {describe(e)}: " for e in element.iter()})
+    )
+    said = [line[len(p) :] for line in report.lines for p in prefixes if line.startswith(p)]
     return "; ".join(said[:4])
 
 
