@@ -112,3 +112,21 @@ def test_build_passes_and_fails_once_the_kept_source_is_changed(tmp_path):
     kept.write_text(original)
     run = CliRunner().invoke(main, ["check", str(result.kit_dir), "--source", str(kept)])
     assert run.exit_code == 0, run.output
+
+
+def test_inertia_is_compared_in_link_axes_whatever_frame_the_urdf_gives_it(tmp_path):
+    """The source's inertial `rpy` 0 0 pi/2 swaps ixx and iyy in link axes: the kit writes the
+    rotated tensor with rpy 0 (importer/links.py), which is the same body."""
+    tilted = _urdf().replace(
+        '<link name="arm"><inertial><mass value="1.0"/>'
+        '<inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/>',
+        '<link name="arm"><inertial><origin xyz="0 0 0.1" rpy="0 0 1.5707963267948966"/>'
+        '<mass value="1.0"/><inertia ixx="0.001" iyy="0.003" izz="0.002" ixy="0" ixz="0" iyz="0"/>',
+    )
+    rotated = tilted.replace(' rpy="0 0 1.5707963267948966"', "").replace(
+        'ixx="0.001" iyy="0.003"', 'ixx="0.003" iyy="0.001"'
+    )
+    assert tilted != _urdf() and rotated != tilted
+    assert _compare(tmp_path, tilted, rotated) == []
+    unrotated = _compare(tmp_path, tilted, tilted.replace(' rpy="0 0 1.5707963267948966"', ""))
+    assert len(unrotated) == 1 and "link 'arm': inertia" in unrotated[0]
