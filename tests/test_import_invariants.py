@@ -157,3 +157,22 @@ def test_usd_articulation_passes_legitimate_small_imports(tmp_path, body, floati
     done = import_robot(urdf, tmp_path / "out", floating=floating)
     result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
     assert any(f.check == "usd.articulation" and f.ok for f in result.findings)
+
+
+@pytest.mark.slow
+def test_step_products_passes_a_robot_without_any_geometry(tmp_path):
+    """A URDF of inertials only (a humanoid's dynamics model): the STEP holds an empty
+    assembly, which is no link product missing or extra."""
+    from simkit.pipeline import build
+
+    bare = [
+        f'<link name="{n}"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" '
+        'ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        for n in ("pelvis", "thigh")
+    ]
+    urdf = tmp_path / "bare.urdf"
+    body = "\n".join([*bare, _joint("pelvis", "thigh", "hip")])
+    urdf.write_text(f'<?xml version="1.0"?>\n<robot name="bare">\n{body}\n</robot>\n')
+    done = import_robot(urdf, tmp_path / "out")
+    result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
+    assert any(f.check == "step.products" and f.ok for f in result.findings)
