@@ -206,7 +206,13 @@ def _open_cache(dir_: str | None, off: bool, readonly: bool, remote: str | None)
 @main.command()
 @click.argument("kit_dir", type=click.Path(path_type=Path))
 @click.option("-v", "--verbose", is_flag=True, help="Print every finding, not only failures.")
-def check(kit_dir: Path, verbose: bool) -> None:
+@click.option(
+    "--source",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also compare the kit with the URDF it was imported from (kinematics, limits, mass).",
+)
+def check(kit_dir: Path, verbose: bool, source: Path | None) -> None:
     """Run the checks on a built kit (folder or zip)."""
     import tempfile
 
@@ -215,13 +221,15 @@ def check(kit_dir: Path, verbose: bool) -> None:
     from simkit.errors import CheckFailed
 
     try:
+        if source is not None and not source.is_file():
+            raise SimkitError(f"{source}: no such source file")
         if kit_dir.is_dir():
             _published_together(kit_dir)
-            findings = run_checks(kit_dir)
+            findings = run_checks(kit_dir, source=source)
         elif kit_dir.is_file():  # a zip: read with kitread's caps, written as plain files
             files = load_kit(kit_dir)
             with tempfile.TemporaryDirectory(prefix="simkit-check-") as tmp:
-                findings = run_checks(unpacked(kit_dir, files, Path(tmp)))
+                findings = run_checks(unpacked(kit_dir, files, Path(tmp)), source=source)
         else:
             raise SimkitError(f"{kit_dir}: no such kit folder or zip")
     except SimkitError as exc:

@@ -362,7 +362,8 @@ def _stage_and_publish(
     findings: list[Finding] = []
     if check:
         say("check")
-        findings = run_checks_cached(staged_kit, files, cache)
+        source = None if robot.source is None else find_spec(target)[0].parent / robot.source[0]
+        findings = run_checks_cached(staged_kit, files, cache, source)
         failed = [f for f in findings if not f.ok]
         if failed:
             lines = "; ".join(f.line() for f in failed[:3])

@@ -37,6 +37,7 @@ _REGISTRY: dict[str, str] = {
     "step": "step:check_step",
     "generated": "generated:check_generated",
     "sdf": "sdf:check_sdf",
+    "source": "source:check_source",
 }
 
 
@@ -68,9 +69,12 @@ class _Checks(Mapping[str, Check]):
 CHECKS: Mapping[str, Check] = _Checks()
 
 
-def run_checks(kit_dir: Path, checks: Mapping[str, Check] | None = None) -> list[Finding]:
-    """Every finding for the kit at `kit_dir`, in a stable order."""
-    kit = Kit.open(kit_dir)
+def run_checks(
+    kit_dir: Path, checks: Mapping[str, Check] | None = None, source: Path | None = None
+) -> list[Finding]:
+    """Every finding for the kit at `kit_dir`, in a stable order; `source`: the URDF it was
+    imported from, for the source comparison (check/source.py)."""
+    kit = Kit.open(kit_dir, source)
     checks = checks or CHECKS
     jobs = {name: partial(_guarded, name, check, kit) for name, check in checks.items()}
     found = run_all(jobs, BACKGROUND)
@@ -106,18 +110,24 @@ CHECK_LIBRARIES = (
 )
 
 
-def run_checks_cached(kit_dir: Path, files: dict[str, bytes], cache: Cache) -> list[Finding]:
+def run_checks_cached(
+    kit_dir: Path, files: dict[str, bytes], cache: Cache, source: Path | None = None
+) -> list[Finding]:
     """`run_checks`, reusing the findings of an earlier build whose kit was byte-identical.
 
     Checks are a pure function of the kit's bytes, simkit's code and the libraries that read
-    them, so those make the content-addressed key. Only passing results are stored;
-    `simkit check` never uses the cache.
+    them, so those make the content-addressed key (with the `source` file's bytes, which the
+    source comparison reads). Only passing results are stored; `simkit check` never uses
+    the cache.
     """
+    parts = [part for path in sorted(files) for part in (path.encode("utf-8"), files[path])]
+    if source is not None:
+        parts += [b"source", source.read_bytes()]
     return cached_stage(
         cache,
         "checks",
-        [part for path in sorted(files) for part in (path.encode("utf-8"), files[path])],
-        lambda: run_checks(kit_dir),
+        parts,
+        lambda: run_checks(kit_dir, source=source),
         lambda found: (
             {"findings": encode_json([asdict(f) for f in found])}
             if all(f.ok for f in found)

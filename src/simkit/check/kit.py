@@ -18,9 +18,11 @@ class Kit:
     """A kit folder on disk."""
 
     root: Path
+    #: the URDF the kit was imported from (check/source.py compares them), when given
+    source: Path | None = None
 
     @staticmethod
-    def open(path: Path) -> Kit:
+    def open(path: Path, source: Path | None = None) -> Kit:
         from simkit.kitio.kitread import read_folder_safely, robot_json_problem
 
         if not (path / "robot.json").is_file():
@@ -31,7 +33,7 @@ class Kit:
         why = robot_json_problem((path / "robot.json").read_bytes())
         if why:
             raise SimkitError(f"{path}: robot.json {why}")
-        return Kit(path)
+        return Kit(path, source)
 
     def path(self, relative: str) -> Path:
         return self.root / relative
@@ -59,6 +61,24 @@ class Kit:
     @property
     def base_frame(self) -> str:
         return self.doc["base_frame"]
+
+    def moved_links(self) -> set[str]:
+        """Links a movable joint moves, directly or through the links above them (robot.json's
+        joints and fixed joints). A floating base alone moves nothing relative to the rest: a
+        rigid robot, floating or fixed (a quadrotor and its props), has none."""
+        above = {j["child"]: (j["parent"], True) for j in self.joints}
+        above.update({j["child"]: (j["parent"], False) for j in self.doc.get("fixed_joints", [])})
+        out: set[str] = set()
+        for link in above:
+            node, seen = link, set()
+            while node in above and node not in seen:
+                seen.add(node)
+                parent, moves = above[node]
+                if moves:
+                    out.add(link)
+                    break
+                node = parent
+        return out
 
     def fk(self, q, target: str | None = None) -> np.ndarray:
         """T_base_target from robot.json's joints (movable and fixed) and frames."""

@@ -361,15 +361,19 @@ def check_usd(kit: Kit) -> list[Finding]:
     if parsed is not None:
         joints = joints_from_parser(parsed)
         arts = parsed.get(UsdPhysics.ObjectType.Articulation, ([], []))[1]
-        bodies = {str(b) for a in arts for b in a.articulatedBodies}
-        # one rigid body and no joint (a quadrotor's frame) articulates nothing: the parser
-        # lists no articulation, or one without bodies; usd.bodies checked its rigid body
-        alone = len(links) == 1 and not kit.joints and not kit.doc.get("fixed_joints")
+        held = {str(b) for a in arts for b in a.articulatedBodies}
+        moved = {str(p) for a in arts for p in a.articulatedJoints}
+        held |= {b for j in joints if j.path in moved for b in (j.body0, j.body1)}
+        # the parser may leave out a body whose only joint is the articulated one from the
+        # world (a hinged cube); a rigid robot (a quadrotor's frame and props, fixed or
+        # floating) has no joint to articulate
+        need = {links[n] for n in kit.moved_links() if n in links}
         findings.append(
             require(
                 "usd.articulation",
-                (len(arts) == 1 and set(links.values()) <= bodies) or (alone and len(arts) <= 1),
-                f"UsdPhysics parser: {len(arts)} articulation(s) holding every link",
+                (len(arts) == 1 and need <= held) or (not need and len(arts) <= 1),
+                f"UsdPhysics parser: {len(arts)} articulation(s) holding every link a joint "
+                f"moves ({len(need)} of {len(links)})",
             )
         )
     else:

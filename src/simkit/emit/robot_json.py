@@ -303,6 +303,12 @@ def emit(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, byte
     a STEP assembly (`geometry.step`, else null)."""
     doc = document(robot, reports)
     doc["geometry"]["step"] = step_geometry(robot) if step else None
+    if robot.source is not None:  # an imported robot; a hand-written spec adds nothing
+        doc["source"] = {"file": robot.source[0], "sha256": robot.source[1]}
+        doc["source_differences"] = [
+            {"what": what, "reason": reason, **({"kit": kit} if kit is not None else {})}
+            for what, reason, kit in robot.source_differences
+        ]
     return {layout.ROBOT_JSON: dumps(doc)}
 
 

@@ -9,8 +9,6 @@ written only when the whole import succeeded.
 from __future__ import annotations
 
 import re
-import shutil
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -153,16 +151,15 @@ def import_robot(
     `hull_collision`: links whose URDF collision has meshes collide with their visual
     solid's convex hull instead (one piece; reported per link). `reading`: what the reader
     may do (xacro args, environment, files outside the package; importer/reading.py)."""
-    from simkit.importer import blocks, convert, meshes, names, source, writer
+    from simkit.importer import blocks, convert, located, meshes, names, provenance, source, writer
+    from simkit.importer.output import publish, staging
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
     report = Report(strict=strict)
     doc = source.load(path, package_dirs, report, reading)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
-        stage = Path(tmp)
+    with staging(out_dir) as stage:  # removed on every way out, SIGTERM included
         mesh_writer = meshes.MeshWriter(stage)
         _up_axis(doc, mesh_writer, report)
         spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
@@ -175,17 +172,15 @@ def import_robot(
         _step_budget(spec, stage, report, doc)
         text = writer.spec_yaml(spec, report.lines, path)
         (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
+        located.check(stage / f"{name}.yaml", spec, doc, renames)  # before the pose fix-ups
         if floating:  # stance.py: out of self-contact with the feet kept, then stand
             text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
         else:  # home.py: out of self-contact, any joint between touching links may move
             _free_home(spec, report, doc, stage / f"{name}.yaml", path)
         _narrow_limits(spec, report, doc, stage / f"{name}.yaml", path)
-        writer.check(stage / f"{name}.yaml")
-        for item in sorted(stage.rglob("*")):
-            if item.is_file():
-                target = out_dir / item.relative_to(stage)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copyfile(item, target)
+        provenance.record(spec, doc, report, renames, stage / f"{name}.yaml", path)
+        located.check(stage / f"{name}.yaml", spec, doc, renames)
+        publish(stage, out_dir)  # each file whole, or one line naming it
     return Imported(
         out_dir / f"{name}.yaml", tuple(report.lines), len(mesh_writer.done), len(spec["links"])
     )

@@ -50,10 +50,15 @@ def keep(spec: dict, source: Source, report: Report, found, renames: dict) -> No
     joint_names = {j["name"] for j in spec["joints"]}
     kept = []
     for element, text in found:
-        text = renamed(text, links, joints)
+        try:  # an entity the file's DOCTYPE defines is not defined inside the block
+            text = renamed(text, links, joints)
+            named = references(ET.fromstring(text))
+        except ET.ParseError as exc:
+            report.dropped(source, element, f"not well-formed on its own ({exc}): left out")
+            continue
         missing = [
             name
-            for kind, name in references(ET.fromstring(text))
+            for kind, name in named
             if name not in (joint_names if kind == "joint" else link_names | joint_names)
         ]
         if missing:

@@ -13,6 +13,8 @@ from simkit.importer.links import has_geometry, has_mass, link_spec
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
 from simkit.importer.source import Source
+from simkit.kitio.oneline import one_line
+from simkit.spec.bounds import MAX_BODIES
 from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 
 TOP = ("link", "joint", "material")
@@ -30,8 +32,16 @@ def _tree(source: Source) -> tuple[dict, dict, str]:
         links[name] = link
     if not links:
         raise source.fail(source.root, "no <link> in the robot")
+    if len(links) > MAX_BODIES:  # refused before any per-link work (a 10,000-link chain)
+        raise source.fail(
+            source.root, f"{len(links)} links: a spec holds at most {MAX_BODIES} (spec/bounds.py)"
+        )
     by_child: dict = {}
+    joint_names: set = set()
     for joint in source.root.findall("joint"):
+        if joint.get("name") in joint_names:
+            raise source.fail(joint, f"joint '{joint.get('name')}' is defined twice")
+        joint_names.add(joint.get("name"))
         for end in ("parent", "child"):
             tag = joint.find(end)
             if tag is not None and tag.get("link") not in links:
@@ -47,13 +57,15 @@ def _tree(source: Source) -> tuple[dict, dict, str]:
         raise source.fail(next(iter(by_child.values())), "the joints form a cycle (no root link)")
     if len(roots) > 1:
         raise source.fail(links[roots[1]], f"links {roots[:3]} have no parent: more than one root")
-    for name in links:  # every link must reach the root
-        seen, at = set(), name
-        while at in by_child:
-            if at in seen:
+    reached = {roots[0]}  # every link must reach the root; each link is walked once
+    for name in links:
+        path, at = [], name
+        while at not in reached:
+            if at in path:
                 raise source.fail(by_child[at], "the joints form a cycle")
-            seen.add(at)
+            path.append(at)
             at = by_child[at].find("parent").get("link")
+        reached.update(path)
     return links, by_child, roots[0]
 
 
@@ -64,25 +76,36 @@ def _children(by_child: dict) -> dict[str, list[str]]:
     return out
 
 
-def _load(source, name, links, kids, by_child) -> tuple[float, float]:
-    """Mass (kg) of a link's subtree and a lever arm (m): the longest chain of joint offsets
-    or CoM offset (a long link without children, such as a neck, holds its CoM that far)."""
-    mass, arm = 0.0, 0.0
-    element = links[name].find("inertial/mass")
-    if has_mass(links[name]):
-        mass = floats(source, element, "value", 1)
-        com = links[name].find("inertial/origin")  # its own CoM is a lever arm too
-        if com is not None:
-            arm = float(np.linalg.norm(floats(source, com, "xyz", 3, "0 0 0")))
-    for child in kids.get(name, []):
-        sub_mass, sub_arm = _load(source, child, links, kids, by_child)
-        xyz = by_child[child].find("origin")
-        offset = (
-            0.0 if xyz is None else float(np.linalg.norm(floats(source, xyz, "xyz", 3, "0 0 0")))
-        )
-        mass += sub_mass
-        arm = max(arm, offset + sub_arm)
-    return mass, max(arm, 0.1)
+def _loads(source, links, kids, by_child, root) -> dict[str, tuple[float, float]]:
+    """Per link: mass (kg) of its subtree and a lever arm (m), the longest chain of joint
+    offsets below it or CoM offset (a long link without children, such as a neck, holds its
+    CoM that far; at least 0.1 m). Children before parents, without recursion: a chain of
+    10,000 links takes linear time."""
+    order, stack = [], [root]
+    while stack:
+        name = stack.pop()
+        order.append(name)
+        stack.extend(kids.get(name, []))
+    out: dict[str, tuple[float, float]] = {}
+    for name in reversed(order):
+        mass, arm = 0.0, 0.0
+        if has_mass(links[name]):
+            mass = floats(source, links[name].find("inertial/mass"), "value", 1)
+            com = links[name].find("inertial/origin")  # its own CoM is a lever arm too
+            if com is not None:
+                arm = float(np.linalg.norm(floats(source, com, "xyz", 3, "0 0 0")))
+        for child in kids.get(name, []):
+            sub_mass, sub_arm = out[child]
+            xyz = by_child[child].find("origin")
+            offset = (
+                0.0
+                if xyz is None
+                else float(np.linalg.norm(floats(source, xyz, "xyz", 3, "0 0 0")))
+            )
+            mass += sub_mass
+            arm = max(arm, offset + sub_arm)
+        out[name] = (mass, max(arm, 0.1))
+    return out
 
 
 def _frame_links(links, by_child, kids, root) -> set[str]:
@@ -125,14 +148,15 @@ def convert(
     links, by_child, root = _tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)
+    loads = _loads(source, links, kids, by_child, root)
     materials, colours = materials_of(source), {}
     root_is_frame = not has_mass(links[root]) and not has_geometry(links[root]) and not floating
     spec_links, spec_joints, spec_frames = [], [], []
-    spec_root = root if root_is_frame else "world"
+    spec_root = root if root_is_frame else _world(links)
     if not root_is_frame:
         joint_type = "floating" if floating else "fixed"
         spec_joints.append(
-            {"name": f"{root}_{joint_type}", "type": joint_type, "parent": "world", "child": root}
+            {"name": f"{root}_{joint_type}", "type": joint_type, "parent": spec_root, "child": root}
         )
     for link_name in links:  # document order
         if link_name == spec_root:
@@ -148,8 +172,7 @@ def convert(
             link_spec(source, links[link_name], writer, report, materials, colours, hull_collision)
         )
         if link_name in by_child:
-            load = _load(source, link_name, links, kids, by_child)
-            spec_joints.append(joint_spec(source, by_child[link_name], report, load))
+            spec_joints.append(joint_spec(source, by_child[link_name], report, loads[link_name]))
     if floating and source.root.find("link/collision") is None:
         if source.root.find("link/visual") is None:
             _estimated_solids(source, spec_links, spec_joints, report)
@@ -159,9 +182,9 @@ def convert(
         report.changed(source, links[root], "massless root of a floating base")
     spec: dict = {
         "name": name,
-        "title": source.root.get("name") or name,
-        "description": f"Imported from {source.path.name} by simkit import.",
-        "sources": [source.path.name],
+        "title": one_line(source.root.get("name") or name),
+        "description": f"Imported from {one_line(source.path.name)} by simkit import.",
+        "sources": [one_line(source.path.name)],
         "root": spec_root,
     }
     if floating:
@@ -191,6 +214,16 @@ def convert(
     if spec_frames:
         spec["frames"] = spec_frames
     return spec
+
+
+def _world(links: dict) -> str:
+    """The spec's root frame above the URDF's root link: `world`, unless a URDF link (one
+    with mass or geometry, which names.py then renames) already has that name."""
+    name, count = "world", 0
+    while name in links:
+        count += 1
+        name = f"world_frame{count if count > 1 else ''}"
+    return name
 
 
 def _visual_collision(source: Source, spec_links: list[dict], report: Report) -> None:

@@ -51,6 +51,34 @@ def placed(xyz, rpy) -> dict:
     return out
 
 
+#: m: the smallest primitive dimension a spec accepts (spec/bounds.py: radius, length, size)
+MIN_SIZE = 1e-3
+
+
+def _too_small(source: Source, shape, report: Report, what: str) -> bool:
+    """A box, cylinder, capsule or sphere with a positive dimension below MIN_SIZE is left out
+    with one report line: the spec refuses it (too small to simulate) and it holds no mass
+    worth keeping (a 0.5 mm collision sphere on a sensor frame)."""
+    keys = {"box": ("size", 3), "sphere": ("radius", 1), "cylinder": ("radius", 1)}
+    keys["capsule"] = keys["cylinder"]
+    if shape.tag not in keys:
+        return False
+    dims = [floats(source, shape, *keys[shape.tag])]
+    if shape.tag in ("cylinder", "capsule"):
+        dims.append(floats(source, shape, "length", 1))
+    flat = [v for d in dims for v in (d if isinstance(d, tuple) else (d,))]
+    small = [v for v in flat if 0 < v < MIN_SIZE]
+    if not small or min(flat) <= 0:
+        return False  # non-positive sizes have their own line below
+    report.dropped(
+        source,
+        shape,
+        f"{what} {shape.tag} of {min(small):g} m is below the {MIN_SIZE:g} m "
+        "a spec simulates: left out",
+    )
+    return True
+
+
 def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: str):
     """One `<visual>`/`<collision>` as (spec primitive dict, MeshInfo or None); None if empty."""
     geometry = element.find("geometry")
@@ -61,6 +89,8 @@ def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: 
     xyz, rpy = origin(source, element)
     pose = placed(xyz, rpy)
     kind = shape.tag
+    if _too_small(source, shape, report, what):
+        return None
     if kind == "box":
         size = floats(source, shape, "size", 3)
         if min(size) <= 0:

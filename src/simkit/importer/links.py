@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from simkit.importer import inertia_limit
 from simkit.importer.geometry import floats, origin, shape_of
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
@@ -99,6 +100,7 @@ def inertial(source: Source, link, report: Report) -> dict:
         out["estimated"] = sorted({*out.get("estimated", []), "inertia"})
         return out
     out["inertia"] = {k: float(round(v, 15)) for k, v in zip(keys, flat, strict=True)}
+    inertia_limit.nudge(source, tag, out, report)  # a flat plate MuJoCo would refuse
     problem = inertia_problem(InertiaSpec(**out["inertia"]))
     if problem:
         report.estimated(source, tag, f"{problem}: balanced (inertia_decision)")

@@ -39,6 +39,8 @@ def _problems(spec: dict) -> dict[tuple[str, int], str]:
     for loc, why in problems(SimpleNamespace(**_construct(spec))):
         if len(loc) == 3 and loc[0] in _REFS and loc[2] == "name":
             out.setdefault((str(loc[0]), int(loc[1])), why)
+        elif tuple(loc) == ("root",):  # a root frame (massless URDF root) is no list item
+            out.setdefault(("root", -1), why)
     return out
 
 
@@ -66,7 +68,8 @@ def make_legal(spec: dict, source: Source, report: Report) -> dict[str, dict[str
         taken = {n.lower() for key in _REFS for n in (i["name"] for i in spec.get(key, []))}
         renames: dict[str, dict[str, str]] = {}
         for (key, index), why in sorted(bad.items()):
-            old = spec[key][index]["name"]
+            old = spec["root"] if key == "root" else spec[key][index]["name"]
+            key = "frames" if key == "root" else key  # renamed like a frame, root included
             new = _spelled(old)
             if new == old or new.lower() in taken:
                 new = f"{new}{_SUFFIX[key]}"

@@ -36,11 +36,14 @@ _Dumper.add_representer(dict, _dict)
 
 def spec_yaml(spec: dict, lines: list[str], source: Path) -> str:
     """The spec text: a header naming the source and each report line, then the spec."""
+    from simkit.kitio.oneline import one_line  # a name holding a newline stays a comment
+
     head = [
-        f"# Imported from {source.name} by `simkit import`. Numbers are the URDF's; values it",
+        f"# Imported from {one_line(source.name)} by `simkit import`. Numbers are the URDF's; "
+        "values it",
         "# lacks are filled, listed under `estimated` and reported here:",
     ]
-    head += [f"#   {line}" for line in lines] or ["#   (nothing estimated or left out)"]
+    head += [f"#   {one_line(line)}" for line in lines] or ["#   (nothing estimated or left out)"]
     body = yaml.dump(spec, Dumper=_Dumper, sort_keys=False, width=100, allow_unicode=False)
     return "\n".join(head) + "\n" + body
 

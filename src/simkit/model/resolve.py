@@ -220,4 +220,6 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         freefall=spec.freefall,
         maintainer=(spec.maintainer.name, spec.maintainer.email) if spec.maintainer else None,
         license=spec.license,
+        source=None if spec.source is None else (spec.source.file, spec.source.sha256),
+        source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
     )

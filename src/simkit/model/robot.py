@@ -278,6 +278,10 @@ class Robot:
     #: package.xml: the spec's maintainer (name, email) and licence, or None (ros2.py defaults)
     maintainer: tuple[str, str] | None = None
     license: str | None = None
+    #: an import's kept source: (file name beside the spec, SHA-256), or None
+    source: tuple[str, str] | None = None
+    #: the kit's intended differences from that source: (what, reason, kit name or None)
+    source_differences: tuple[tuple[str, str, str | None], ...] = ()
 
     def link(self, name: str) -> Link:
         for link in self.links:

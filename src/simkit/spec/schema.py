@@ -310,6 +310,26 @@ class PlanningGroupSpec(Strict):
     tip: str
 
 
+class SourceSpec(Strict):
+    """The file a spec was imported from, kept beside it (`simkit import` writes
+    NAME.source.urdf, the expanded URDF), and its SHA-256: the source check compares the kit
+    with it (check/source.py). The kit never carries the file, only the digest."""
+
+    #: a file name in the spec's folder (no folders, so it cannot point elsewhere)
+    file: Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")]
+    sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
+
+
+class SourceDifference(Strict):
+    """One intended difference between the kit and its source (`what`: `links.NAME.FIELD`,
+    `joints.NAME.FIELD`, `links.NAME` or `joints.NAME` for an added element), with why.
+    `kit`: the kit's name for a renamed element (`what` = `links.OLD.name`)."""
+
+    what: Annotated[str, Field(min_length=1)]
+    reason: Annotated[str, Field(min_length=1)]
+    kit: str | None = None
+
+
 class RobotSpec(Strict):
     """The whole robot spec (one YAML file)."""
 
@@ -348,3 +368,6 @@ class RobotSpec(Strict):
     #: without them the ROS 2 package gets emit/ros2.py's defaults and the build a warning
     maintainer: MaintainerSpec | None = None
     license: Annotated[str, Field(min_length=1, pattern=r"^[^\n]+$")] | None = None
+    #: the imported source file and its digest, and the kit's intended differences from it
+    source: SourceSpec | None = None
+    source_differences: tuple[SourceDifference, ...] = ()

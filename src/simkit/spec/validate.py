@@ -46,7 +46,38 @@ def inertia_problem(inertia: InertiaSpec) -> str | None:
             f"inertia breaks the triangle inequality: principal moments {_fmt3(eig)} kg m^2, "
             f"{a:.6g} + {b:.6g} < {c:.6g}"
         )
+    if mujoco_refuses(inertia):
+        return (
+            f"inertia is on the triangle-inequality limit: principal moments {_fmt3(eig)} kg "
+            f"m^2, {a:.6g} + {b:.6g} = {c:.6g}, which MuJoCo refuses after rounding"
+        )
     return None
+
+
+#: relative margin for a full tensor: numpy's and MuJoCo's eigenvalues differ by round-off
+#: (a few ulps), so a tensor on the limit within this is refused rather than left to chance
+EIG_MARGIN = 1e-12
+
+
+def mujoco_refuses(inertia: InertiaSpec) -> bool:
+    """Whether MuJoCo's compiler would refuse the tensor as the kit writes it (kitio/fmt.py's
+    10 digits): it tests A + B >= C on the principal moments with no tolerance. A diagonal
+    tensor's moments are its diagonal, tested here exactly as MuJoCo does; a full one's are
+    eigenvalues, tested with EIG_MARGIN."""
+    from simkit.kitio.fmt import num
+
+    values = [
+        float(num(v))
+        for v in (inertia.ixx, inertia.iyy, inertia.izz, inertia.ixy, inertia.ixz, inertia.iyz)
+    ]
+    x, y, z = values[:3]
+    if not any(values[3:]):
+        return x + y < z or x + z < y or y + z < x
+    tensor = np.array(
+        [[x, values[3], values[4]], [values[3], y, values[5]], [values[4], values[5], z]]
+    )
+    a, b, c = sorted(np.linalg.eigvalsh(tensor))
+    return bool(a + b < c * (1 + EIG_MARGIN))
 
 
 def _fmt3(values: np.ndarray) -> str:
@@ -298,11 +329,17 @@ def _mesh_files(spec: RobotSpec, base_dir: Path) -> Iterator[Problem]:
                 yield ("links", i, "solid", k, "file"), f"mesh file not found: {prim.file}"
 
 
+def _source_file(spec: RobotSpec, base_dir: Path) -> Iterator[Problem]:
+    """An imported spec's kept source (`source.file`, beside the spec) exists."""
+    if spec.source is not None and not (base_dir / spec.source.file).is_file():
+        yield ("source", "file"), f"source file not found: {spec.source.file}"
+
+
 def load_spec(path: Path, display: str | None = None) -> tuple[RobotSpec, SourceDoc]:
     """Read and validate one spec file."""
     doc = load_yaml(path, display)
     spec = validate(doc)
-    problems = list(_mesh_files(spec, path.parent))
+    problems = list(_mesh_files(spec, path.parent)) + list(_source_file(spec, path.parent))
     if problems:
         raise _first(problems, doc)
     return spec, doc

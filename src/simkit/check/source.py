@@ -1,0 +1,263 @@
+"""The kit is the robot it was imported from: re-read the source URDF with an independent
+reader (yourdfpy, not the importer's lxml walk) and compare its kinematics, limits and mass
+properties with the kit's written URDF. Every difference must be listed, with its reason, in
+robot.json's `source_differences`; any other fails, naming the joint or link.
+
+Names: `what` keys use the source's names (`joints.J.axis`, `links.L.mass`); a renamed
+element is `links.L.name` / `joints.J.name` with the kit's name in `kit`; an element the kit
+adds is `links.NAME` / `joints.NAME` (kit name), one the kit leaves out `links.L` (source).
+Units: m, rad, kg, kg m^2, all in the link or joint frame the URDF defines.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from simkit.check.findings import Finding, require
+from simkit.check.kit import Kit
+from simkit.kitio.oneline import one_line
+
+#: relative tolerance: the kit carries 10 significant digits (kitio/fmt.py); a hand-typed
+#: source rarely more. Far below any real change (an axis turned, a mass 10 % off).
+REL = 1e-6
+#: m: absolute floor for lengths; kg m^2 floor for inertia terms is REL x the largest moment
+ABS_LENGTH = 1e-9
+#: failures named per finding category before "and N more"
+SHOWN = 20
+
+
+@dataclass
+class Allowed:
+    """robot.json's `source_differences`: allowed keys and the source -> kit renames."""
+
+    keys: set[str] = field(default_factory=set)
+    links: dict[str, str] = field(default_factory=dict)
+    joints: dict[str, str] = field(default_factory=dict)
+
+    @staticmethod
+    def of(doc: dict) -> Allowed:
+        """From robot.json (or any dict with `source_differences`)."""
+        out = Allowed()
+        for item in doc.get("source_differences", []):
+            what = str(item.get("what", ""))
+            out.keys.add(what)
+            kind, _, rest = what.partition(".")
+            name, _, attr = rest.rpartition(".")
+            if attr == "name" and isinstance(item.get("kit"), str) and kind in ("links", "joints"):
+                getattr(out, kind)[name] = item["kit"]
+        return out
+
+
+def load_urdf(path: Path):
+    """The URDF's robot as yourdfpy reads it (no meshes loaded: kinematics and inertials)."""
+    import logging
+
+    import yourdfpy  # lazy: pulls in trimesh
+
+    logging.getLogger("yourdfpy").setLevel(logging.ERROR)
+    return yourdfpy.URDF.load(
+        str(path), load_meshes=False, build_scene_graph=False, build_collision_scene_graph=False
+    ).robot
+
+
+def check_source(kit: Kit) -> list[Finding]:
+    """The comparison, when the build or `simkit check --source` gave a source file; no
+    findings otherwise (a hand-written spec has no source)."""
+    if kit.source is None:
+        return []
+    findings = _digest(kit, kit.source)
+    try:
+        source = load_urdf(kit.source)
+    except Exception as exc:  # yourdfpy raises several types on bad input
+        why = " ".join(str(exc).split())[:200]
+        return [*findings, require("source.read", False, f"yourdfpy cannot read the source: {why}")]
+    try:
+        built = load_urdf(kit.path(kit.urdf))
+    except Exception as exc:
+        why = " ".join(str(exc).split())[:200]
+        return [*findings, require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
+    return findings + compare_robots(source, built, Allowed.of(kit.doc))
+
+
+def _digest(kit: Kit, path: Path) -> list[Finding]:
+    """The source file is the one the import recorded (robot.json `source.sha256`)."""
+    recorded = (kit.doc.get("source") or {}).get("sha256")
+    if recorded is None:
+        return []
+    actual = hashlib.sha256(path.read_bytes()).hexdigest()
+    return [
+        require(
+            "source.digest",
+            actual == recorded,
+            f"{path.name} is the file the import recorded (sha256 {recorded[:12]}...)"
+            if actual == recorded
+            else f"{path.name} was changed after the import: sha256 {actual[:12]}..., "
+            f"robot.json records {recorded[:12]}...",
+        )
+    ]
+
+
+def compare_robots(source, built, allowed: Allowed) -> list[Finding]:
+    """Findings for yourdfpy robots `source` and `built` (the kit's URDF)."""
+    out: list[Finding] = []
+    links = {link.name: link for link in built.links}
+    joints = {joint.name: joint for joint in built.joints}
+    seen_links, seen_joints = set(), set()
+    link_problems: list[str] = []
+    for link in source.links:
+        name = _kit_name(allowed.links, link.name, links)
+        if name not in links:
+            if f"links.{one_line(link.name)}" not in allowed.keys:
+                link_problems.append(f"link '{one_line(link.name)}' is missing from the kit")
+            continue
+        seen_links.add(name)
+        link_problems += _mass(link, links[name], allowed)
+    joint_problems: list[str] = []
+    for joint in source.joints:
+        name = _kit_name(allowed.joints, joint.name, joints)
+        if name not in joints:
+            if f"joints.{one_line(joint.name)}" not in allowed.keys:
+                joint_problems.append(f"joint '{one_line(joint.name)}' is missing from the kit")
+            continue
+        seen_joints.add(name)
+        joint_problems += _joint(joint, joints[name], allowed)
+    link_problems += [
+        f"link '{n}' is in the kit, not in the source"
+        for n in sorted(set(links) - seen_links)
+        if f"links.{n}" not in allowed.keys
+    ]
+    joint_problems += [
+        f"joint '{n}' is in the kit, not in the source"
+        for n in sorted(set(joints) - seen_joints)
+        if f"joints.{n}" not in allowed.keys
+    ]
+    out += _findings(
+        "source.links",
+        link_problems,
+        f"{len(source.links)} links: names, masses, "
+        "CoMs and inertias agree with the source or are listed differences",
+    )
+    out += _findings(
+        "source.joints",
+        joint_problems,
+        f"{len(source.joints)} joints: names, "
+        "types, parents, children, origins, axes and limits agree with the source "
+        "or are listed differences",
+    )
+    return out
+
+
+def _kit_name(renames: dict[str, str], name: str, kit: dict) -> str:
+    """The kit's name of source element `name`: as listed renamed, else its own."""
+    new = renames.get(one_line(name), name)
+    return new if new in kit or name not in kit else name
+
+
+def _findings(check: str, problems: list[str], ok_detail: str) -> list[Finding]:
+    if not problems:
+        return [require(check, True, ok_detail)]
+    out = [require(check, False, p + " (not listed in source_differences)") for p in problems]
+    if len(out) > SHOWN:
+        out = [*out[:SHOWN], require(check, False, f"and {len(out) - SHOWN} more")]
+    return out
+
+
+def _close(a, b, scale: float, floor: float) -> bool:
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return bool(np.all(np.abs(a - b) <= REL * scale + floor))
+
+
+def _mass_properties(link) -> tuple[float, np.ndarray, np.ndarray]:
+    """(mass kg, CoM m, inertia about the CoM in link axes kg m^2); zeros without inertial."""
+    inertial = link.inertial
+    if inertial is None:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    origin = np.eye(4) if inertial.origin is None else np.asarray(inertial.origin, dtype=float)
+    tensor = np.zeros((3, 3)) if inertial.inertia is None else np.asarray(inertial.inertia)
+    rot = origin[:3, :3]
+    return float(inertial.mass or 0.0), origin[:3, 3].copy(), rot @ tensor @ rot.T
+
+
+def _mass(src, kit, allowed: Allowed) -> list[str]:
+    """Mass, CoM and inertia of one link, each unless listed."""
+    key, shown = f"links.{one_line(src.name)}", one_line(src.name)
+    m0, c0, i0 = _mass_properties(src)
+    m1, c1, i1 = _mass_properties(kit)
+    out = []
+    if f"{key}.mass" not in allowed.keys and not _close(m0, m1, abs(m0), 0.0):
+        out.append(f"link '{shown}': mass {m0:.9g} kg in the source, {m1:.9g} in the kit")
+    if f"{key}.com" not in allowed.keys and not _close(
+        c0, c1, float(np.max(np.abs(c0))), ABS_LENGTH
+    ):
+        out.append(f"link '{shown}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
+    scale = float(np.max(np.abs(i0)))
+    if f"{key}.inertia" not in allowed.keys and not _close(i0, i1, scale, 0.0):
+        out.append(
+            f"link '{shown}': inertia (link axes) {_v(np.diag(i0))} kg m^2 on the diagonal "
+            f"in the source, {_v(np.diag(i1))} in the kit"
+        )
+    return out
+
+
+def _joint(src, kit, allowed: Allowed) -> list[str]:
+    """Type, parent, child, origin, axis and limits of one joint, each unless listed."""
+    key, name = f"joints.{one_line(src.name)}", f"joint '{one_line(src.name)}'"
+    out = []
+
+    def differs(attr: str, a, b) -> None:
+        if f"{key}.{attr}" not in allowed.keys:
+            out.append(f"{name}: {attr} {a} in the source, {b} in the kit")
+
+    if src.type != kit.type:
+        differs("type", src.type, kit.type)
+    for end in ("parent", "child"):
+        want = allowed.links.get(one_line(getattr(src, end)), getattr(src, end))
+        if want != getattr(kit, end):
+            differs(end, getattr(src, end), getattr(kit, end))
+    o0 = np.eye(4) if src.origin is None else np.asarray(src.origin, dtype=float)
+    o1 = np.eye(4) if kit.origin is None else np.asarray(kit.origin, dtype=float)
+    length = float(np.max(np.abs(o0[:3, 3])))
+    same = _close(o0[:3, 3], o1[:3, 3], length, ABS_LENGTH)
+    if not (same and _close(o0[:3, :3], o1[:3, :3], 1, 0)):
+        differs("origin", f"xyz {_v(o0[:3, 3])}", f"xyz {_v(o1[:3, 3])} (or its rotation)")
+    if src.type in ("fixed", "floating") or kit.type in ("fixed", "floating"):
+        return out
+    a0, a1 = _unit(src.axis), _unit(kit.axis)
+    if not _close(a0, a1, 1, 0):
+        differs("axis", _v(a0), _v(a1))
+    out += _limits(src, kit, allowed, key, name)
+    return out
+
+
+def _limits(src, kit, allowed: Allowed, key: str, name: str) -> list[str]:
+    """lower/upper (not for continuous), velocity and effort: URDF's <limit>."""
+    out = []
+    fields = [("max_velocity", "velocity"), ("effort_peak", "effort")]
+    if src.type != "continuous" and kit.type != "continuous":
+        fields = [("lower", "lower"), ("upper", "upper"), *fields]
+    for attr, urdf_attr in fields:
+        a = None if src.limit is None else getattr(src.limit, urdf_attr)
+        b = None if kit.limit is None else getattr(kit.limit, urdf_attr)
+        if f"{key}.{attr}" in allowed.keys:
+            continue
+        if a is None or b is None:
+            if (a is None) != (b is None):
+                out.append(f"{name}: {urdf_attr} {a} in the source, {b} in the kit")
+            continue
+        if not _close(a, b, abs(float(a)), 0.0):
+            out.append(f"{name}: {urdf_attr} {float(a):.9g} in the source, {float(b):.9g} in kit")
+    return out
+
+
+def _unit(axis) -> np.ndarray:
+    a = np.asarray((1.0, 0.0, 0.0) if axis is None else axis, dtype=float)
+    norm = float(np.linalg.norm(a))
+    return a / norm if norm > 0 else a
+
+
+def _v(values) -> str:
+    return "(" + ", ".join(f"{float(v):.6g}" for v in np.ravel(values)) + ")"

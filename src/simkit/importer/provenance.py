@@ -1,0 +1,156 @@
+"""Where the kit came from and where it differs: the last step of an import.
+
+The import keeps the expanded source URDF beside the spec (`NAME.source.urdf`, the document
+the importer read, xacro expanded, comments dropped), records its SHA-256 in the spec's
+`source`, and lists every intended difference between the kit and that source in
+`source_differences`, each with its reason. The build's source check (check/source.py)
+re-reads the kept file with yourdfpy and fails on any difference not listed. Keys use the
+URDF's names: `links.L.FIELD`, `joints.J.FIELD`, `links.L.name` (renamed, `kit` = new name),
+`links.NAME` / `joints.NAME` (added by the kit).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from simkit.importer.report import Report
+from simkit.importer.source import Source, describe, line_of
+from simkit.kitio.oneline import one_line
+from simkit.spec.bounds import MAX_STRING
+
+#: spec fields of a link or joint the source check compares, as its `estimated` names them
+COMPARED = {
+    "links": ("mass", "com", "inertia"),
+    "joints": ("lower", "upper", "max_velocity", "effort_peak"),
+}
+GENERIC = {
+    "mass": "the URDF gives no usable mass: estimated",
+    "com": "the URDF gives no centre of mass: estimated",
+    "inertia": "the URDF's inertia is missing or cannot be simulated: estimated",
+    "lower": "the URDF gives no usable position limits: estimated",
+    "upper": "the URDF gives no usable position limits: estimated",
+    "max_velocity": "the URDF's velocity limit is missing or a placeholder: estimated",
+    "effort_peak": "the URDF's effort limit is missing or a placeholder: estimated",
+}
+
+
+def source_name(spec: dict) -> str:
+    """The kept source's file name, beside the spec."""
+    return f"{spec['name']}.source.urdf"
+
+
+def record(
+    spec: dict,
+    source: Source,
+    report: Report,
+    renames: dict[str, dict[str, str]],
+    spec_path: Path,
+    urdf_path: Path,
+) -> None:
+    """Write the kept source beside `spec_path`, add `source` and `source_differences` to
+    `spec` and rewrite the spec file (its header keeps the report lines)."""
+    from lxml import etree
+
+    from simkit.importer import writer
+
+    data = etree.tostring(source.root.getroottree(), xml_declaration=True, encoding="utf-8")
+    data = data.rstrip(b"\n") + b"\n"
+    name = source_name(spec)
+    (spec_path.parent / name).write_bytes(data)
+    spec["source"] = {"file": name, "sha256": hashlib.sha256(data).hexdigest()}
+    spec["source_differences"] = differences(spec, source, report, renames)
+    spec_path.write_text(writer.spec_yaml(spec, report.lines, urdf_path), encoding="utf-8")
+
+
+def differences(
+    spec: dict, source: Source, report: Report, renames: dict[str, dict[str, str]]
+) -> list[dict]:
+    """Every intended difference between the spec's kit and the URDF, sorted by `what`."""
+    back = {new: old for table in renames.values() for old, new in table.items()}
+    out: dict[str, dict] = {}
+
+    def add(what: str, reason: str, kit: str | None = None) -> None:
+        what, reason = one_line(what), one_line(reason)  # URDF names may hold a newline
+        if len(reason) > MAX_STRING:  # a one-line URDF: every report line matches its line
+            reason = reason[: MAX_STRING - 3] + "..."
+        out.setdefault(what, {"what": what, "reason": reason, **({"kit": kit} if kit else {})})
+
+    for kind, table in sorted(renames.items()):
+        key = "joints" if kind == "joints" else "links"
+        for old, new in sorted(table.items()):
+            add(f"{key}.{old}.name", f"renamed: '{old}' is not a name the kit can hold", new)
+    _added(spec, source, back, add)
+    _frames(spec, source, back, add)
+    for kind, fields in COMPARED.items():
+        tag = kind[:-1]
+        for item in spec.get(kind, []):
+            old = back.get(item["name"], item["name"])
+            element = source.root.find(f"{tag}[@name='{_quoted(old)}']")
+            said = _said(report, source, element)
+            for field in item.get("estimated", []):
+                if field in fields:
+                    add(f"{kind}.{old}.{field}", said or GENERIC[field])
+            if kind == "links" and element is not None:
+                _dropped(report, source, element, f"links.{old}", add)
+            if kind == "links" and item.get("inertia_decision"):
+                add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
+            if kind == "joints" and element is not None and element.get("type") != item["type"]:
+                add(f"joints.{old}.type", said or f"a {element.get('type')} joint in the URDF")
+    return [out[k] for k in sorted(out)]
+
+
+def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
+    """A fixed base bolts the URDF's root link to a root frame (`world`) the URDF lacks."""
+    root = spec["root"]
+    if source.root.find(f"link[@name='{_quoted(back.get(root, root))}']") is not None:
+        return  # the URDF's own massless root link is the kit's root
+    for joint in spec["joints"]:
+        if joint["parent"] == root and joint["type"] == "fixed":
+            add(f"links.{root}", "added: the world the fixed base is bolted to")
+            add(f"joints.{joint['name']}", "added: bolts the URDF's root link to the world")
+
+
+def _frames(spec: dict, source: Source, back: dict[str, str], add) -> None:
+    """A massless, geometry-free leaf on a fixed joint is a kit frame, whose fixed joint the
+    kit's URDF names `FRAME_joint` (emit/urdf.py)."""
+    for frame in spec.get("frames", []):
+        old = back.get(frame["name"], frame["name"])
+        for joint in source.root.findall("joint"):
+            child = joint.find("child")
+            if child is not None and child.get("link") == old:
+                kit = frame.get("joint", f"{frame['name']}_joint")
+                if joint.get("name") != kit:
+                    reason = "the massless leaf link is a kit frame, its joint named FRAME_joint"
+                    add(f"joints.{joint.get('name')}.name", reason, kit)
+
+
+def _dropped(report: Report, source: Source, link, key: str, add) -> None:
+    """A visual or collision element the import left out (unreadable mesh, a primitive below
+    a millimetre, ...): listed for the record (the check compares no geometry)."""
+    for tag in ("visual", "collision"):
+        said = [
+            m.split(": ", 1)[-1]
+            for part in link.findall(tag)
+            for m in _said(report, source, part).split("; ")
+            if m.startswith(f"not imported: {tag} ")
+        ]
+        if said:
+            add(f"{key}.{tag}", "left out: " + "; ".join(said[:4]))
+
+
+def _said(report: Report, source: Source, element) -> str:
+    """The report's messages about `element` or an element inside it (each report line
+    starts `FILE:LINE: ELEMENT: `, so a URDF on one line still tells a link from a joint)."""
+    if element is None:
+        return ""
+    prefixes = tuple(
+        sorted({f"{source.path.name}:{line_of(e)}: {describe(e)}: " for e in element.iter()})
+    )
+    said = [line[len(p) :] for line in report.lines for p in prefixes if line.startswith(p)]
+    return "; ".join(said[:4])
+
+
+def _quoted(name: str) -> str:
+    """A name usable inside an XPath `[@name='...']` (one with a quote matches nothing)."""
+    return name if "'" not in name else "\0"
