@@ -73,8 +73,7 @@ def publish(
     out_dir = Path(out_dir)
     _check_out_dir(out_dir)
     names = list(targets) if targets else robot_names()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    with atomic.locked(out_dir.parent):  # one publish into a folder at a time
+    with atomic.locked(out_dir.parent):  # creates the parent; one line if it cannot  # one publish into a folder at a time
         atomic.recover_folder(out_dir)
         return _publish_locked(out_dir, names, say, {**build_options, "on_ray": on_ray})
 
@@ -84,9 +83,12 @@ def _publish_locked(
 ) -> dict:
     """`publish` with the lock held: build every kit and the index into a staging folder
     beside `out_dir`, then swap it in as one unit (`atomic.swap_folder`)."""
-    staging = Path(
-        tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".staging", dir=out_dir.parent)
-    )
+    try:
+        staging = Path(
+            tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".staging", dir=out_dir.parent)
+        )
+    except OSError as exc:
+        raise SimkitError(f"{out_dir.parent}: cannot create a folder: {exc.strerror}") from None
     try:
         site, work = staging / "site", staging / "kits"
         site.mkdir()
