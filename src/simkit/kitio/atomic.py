@@ -150,12 +150,15 @@ def staging_area(out_dir: Path, robot: str) -> Iterator[Path]:
     so it is gone then), `out_dir` gets back its mtime: a build that changed nothing, or
     failed, leaves no trace there."""
     st = out_dir.stat()
-    path = staging(out_dir, robot)
+    path = None
     try:
+        with interrupt.held():  # a signal right after mkdir still finds `path` set
+            path = staging(out_dir, robot)
         yield path
     finally:
-        published = not path.exists()
-        _remove(path)
+        published = path is not None and not path.exists()
+        if path is not None:
+            _remove(path)
         if not published:
             os.utime(out_dir, ns=(st.st_atime_ns, st.st_mtime_ns))
 
