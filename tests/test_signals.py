@@ -339,3 +339,45 @@ def test_an_unwritable_out_is_one_line_naming_the_path(tmp_path, command):
     assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
     assert str(blocker) in lines[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "chain.urdf", "tmp"]
+
+
+#: A process pool as `derive/per_link.py` runs CoACD in (spawned workers; `shutdown` in a
+#: `finally`), its one job far longer than the test waits.
+POOL = """
+import multiprocessing, sys, time
+from concurrent.futures import ProcessPoolExecutor
+from simkit.kitio import interrupt
+with interrupt.installed():
+    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        future = pool.submit(time.sleep, 120)
+        print("submitted", flush=True)
+        future.result()
+    finally:
+        pool.shutdown(cancel_futures=True)
+"""
+
+
+def test_sigterm_ends_pool_workers_instead_of_waiting_for_their_jobs(tmp_path):
+    """Without ending them, `shutdown` waits for the running job (120 s here)."""
+    tag = uuid.uuid4().hex
+    proc = subprocess.Popen(
+        [sys.executable, "-c", POOL],
+        env=_env(tmp_path, tag),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout.readline().strip() == "submitted"
+    deadline = time.monotonic() + 60
+    while len(_tagged(tag)) < 2 and time.monotonic() < deadline:  # the worker has started
+        time.sleep(0.02)
+    start = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    try:
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert time.monotonic() - start < 60
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert _tagged(tag) == []
