@@ -44,6 +44,17 @@ class _Main(click.Group):
             where = f"{exc.filename}: " if exc.filename is not None else ""
             _fail(SimkitError(f"{where}{exc.strerror or exc}"))
 
+    def invoke(self, ctx: click.Context) -> Any:
+        """A Ctrl-C no command handled is `Interrupted` (130), not click's `Aborted!`."""
+        import signal
+
+        from simkit.kitio import interrupt
+
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            raise interrupt.Interrupted(signal.SIGINT) from None
+
 
 @click.group(cls=_Main, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="simkit")

@@ -2,11 +2,13 @@
 
 Python's default SIGTERM (and SIGHUP) kill the process at once: no `finally` runs, so a
 build's staging folder, a publish's site folder and an import's `.import-*` folder stay
-behind, and forked workers may outlive it. `installed()` (the CLI entry) turns each into
-`Interrupted`, a `SystemExit` with the conventional code (128 + the signal: 130 for SIGINT,
-143 for SIGTERM), so every `finally` and context manager runs: staging folders are removed,
-locks released, forked children stopped and reaped. Further signals are ignored from then
-on, so the clean-up is not cut short.
+behind, and forked workers may outlive it. `installed()` (the CLI entry) turns SIGTERM and
+SIGHUP into `Interrupted`, a `SystemExit` with the conventional code (128 + the signal: 143
+for SIGTERM), and SIGINT into `KeyboardInterrupt` as Python does (so code that stops on
+Ctrl-C, such as `simkit view`, still does; the CLI turns an unhandled one into
+`Interrupted`, 130). Either way every `finally` and context manager runs: staging folders
+are removed, locks released, forked children stopped and reaped. Further signals are
+ignored from then on, so the clean-up is not cut short.
 
 `held()` marks a section that must finish once begun (publishing a kit's folder, zip and
 manifest): a signal that arrives inside it takes effect when the section ends. The Python
@@ -50,10 +52,13 @@ def _handler(signum: int, _frame: object) -> None:
 
 
 def _interrupt(signum: int) -> None:
-    """Ignore further signals, stop pool workers, and raise `Interrupted`."""
+    """Ignore further signals, stop pool workers, and raise `KeyboardInterrupt` (SIGINT) or
+    `Interrupted`."""
     for sig in SIGNALS:
         signal.signal(sig, signal.SIG_IGN)
     _stop_pool_workers()
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise Interrupted(signum)
 
 
