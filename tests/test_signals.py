@@ -168,8 +168,7 @@ def _chain_urdf(path: Path, links: int) -> None:
     )
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: s.name)
+@pytest.mark.parametrize("sig", [*SIGNALS, signal.SIGHUP], ids=lambda s: s.name)
 def test_import_interrupted_while_staging_cleans_up_and_keeps_the_spec(tmp_path, sig):
     urdf = tmp_path / "chain.urdf"
     _chain_urdf(urdf, 30)
