@@ -336,8 +336,9 @@ def test_an_unwritable_out_is_one_line_naming_the_path(tmp_path, command):
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    assert str(blocker) in lines[0]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "chain.urdf", "tmp"]
+    assert str(blocker) in lines[0], lines[0]
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == ["a_file", "chain.urdf", "tmp"], left
 
 
 #: A process pool as `derive/per_link.py` runs CoACD in (spawned workers; `shutdown` in a
