@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 from rich.console import Console
@@ -25,7 +25,38 @@ def _fail(exc: SimkitError) -> None:
     sys.exit(exc.exit_code)
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Main(click.Group):
+    """The `simkit` group: SIGTERM, SIGINT and SIGHUP run the normal clean-up (staging
+    folders removed, locks released, workers stopped), then one line and 128 + signal. An
+    I/O error no command turned into a `SimkitError` (an unwritable path, a full disk) is one
+    line naming the path, after the same clean-up."""
+
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        from simkit.kitio import interrupt
+
+        try:
+            with interrupt.installed():
+                return super().main(*args, **kwargs)
+        except interrupt.Interrupted as exc:
+            err.print(f"simkit: {exc.line()}", markup=False)
+            sys.exit(exc.code)
+        except OSError as exc:  # click itself handles a closed pipe (EPIPE)
+            where = f"{exc.filename}: " if exc.filename is not None else ""
+            _fail(SimkitError(f"{where}{exc.strerror or exc}"))
+
+    def invoke(self, ctx: click.Context) -> Any:
+        """A Ctrl-C no command handled is `Interrupted` (130), not click's `Aborted!`."""
+        import signal
+
+        from simkit.kitio import interrupt
+
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            raise interrupt.Interrupted(signal.SIGINT) from None
+
+
+@click.group(cls=_Main, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="simkit")
 def main() -> None:
     """Turn robot specs into complete, checked simulation kits."""

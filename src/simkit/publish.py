@@ -27,7 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from simkit.errors import SimkitError
-from simkit.kitio import atomic, layout, reuse
+from simkit.kitio import atomic, interrupt, layout, reuse
 from simkit.kitio.jsonout import dumps
 from simkit.kitio.resources import robot_names
 from simkit.pipeline import build, find_spec, write_tree
@@ -73,8 +73,7 @@ def publish(
     out_dir = Path(out_dir)
     _check_out_dir(out_dir)
     names = list(targets) if targets else robot_names()
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    with atomic.locked(out_dir.parent):  # one publish into a folder at a time
+    with atomic.locked(out_dir.parent):  # one publish at a time; makes the parent (one line)
         atomic.recover_folder(out_dir)
         return _publish_locked(out_dir, names, say, {**build_options, "on_ray": on_ray})
 
@@ -84,10 +83,10 @@ def _publish_locked(
 ) -> dict:
     """`publish` with the lock held: build every kit and the index into a staging folder
     beside `out_dir`, then swap it in as one unit (`atomic.swap_folder`)."""
-    staging = Path(
-        tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".staging", dir=out_dir.parent)
-    )
+    staging = None
     try:
+        with interrupt.held():  # a signal right after mkdir still finds `staging` set
+            staging = _make_staging(out_dir)
         site, work = staging / "site", staging / "kits"
         site.mkdir()
         kits = []
@@ -127,8 +126,18 @@ def _publish_locked(
                 reuse.keep_folder_times(site, out_dir)
             atomic.swap_folder(site, out_dir)
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     return index
+
+
+def _make_staging(out_dir: Path) -> Path:
+    """A fresh staging folder beside `out_dir`; one line when it cannot be made."""
+    try:
+        made = tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".staging", dir=out_dir.parent)
+    except OSError as exc:
+        raise SimkitError(f"{out_dir.parent}: cannot create a folder: {exc.strerror}") from None
+    return Path(made)
 
 
 def _build_all(names: list[str], work: Path, say: Callable[[str], None], options: dict) -> list:

@@ -24,8 +24,13 @@ old kit moved into the journal and the new one into place; a kill between them l
 folder until the next build finishes the publish. A kit folder left as a symlink by an
 earlier simkit (`.NAME.current` generations) is replaced by the same exchange.
 
-Builds into one folder serialize on an `flock` of the folder itself (no lock file). Test hook:
-`SIMKIT_TEST_KILL_AT=<step>` kills the process with SIGKILL at that step.
+SIGTERM, SIGINT or SIGHUP (`kitio/interrupt.py`) arriving once the journal is written take
+effect when the publish is complete: the section from the journal to `cleaned` is `held`.
+Before it, the staging folder is removed and the published kit is untouched.
+
+Builds into one folder serialize on an `flock` of the folder itself (no lock file). Test
+hooks: `SIMKIT_TEST_KILL_AT=<step>` kills the process with SIGKILL at that step;
+`SIMKIT_TEST_SIGNAL_AT=<step>` sends it SIGTERM there.
 """
 
 from __future__ import annotations
@@ -40,9 +45,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from simkit.errors import SimkitError
-from simkit.kitio import layout, manifest, reuse
+from simkit.kitio import interrupt, layout, manifest, reuse
 
 KILL_ENV = "SIMKIT_TEST_KILL_AT"
+SIGNAL_ENV = "SIMKIT_TEST_SIGNAL_AT"
 #: The publishing steps, in order, at which the test hook can kill a build.
 STEPS = (
     "locked",
@@ -62,9 +68,12 @@ _OLD_KIT = "old_kit"
 
 
 def step(name: str) -> None:
-    """Test hook: die here (SIGKILL, no cleanup) when `SIMKIT_TEST_KILL_AT` names this step."""
+    """Test hooks: die here (SIGKILL, no cleanup) when `SIMKIT_TEST_KILL_AT` names this step;
+    send SIGTERM (the normal clean-up) when `SIMKIT_TEST_SIGNAL_AT` does."""
     if os.environ.get(KILL_ENV) == name:
         os.kill(os.getpid(), signal.SIGKILL)
+    if os.environ.get(SIGNAL_ENV) == name:
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 def _writable(out_dir: Path) -> None:
@@ -141,12 +150,15 @@ def staging_area(out_dir: Path, robot: str) -> Iterator[Path]:
     so it is gone then), `out_dir` gets back its mtime: a build that changed nothing, or
     failed, leaves no trace there."""
     st = out_dir.stat()
-    path = staging(out_dir, robot)
+    path = None
     try:
+        with interrupt.held():  # a signal right after mkdir still finds `path` set
+            path = staging(out_dir, robot)
         yield path
     finally:
-        published = not path.exists()
-        _remove(path)
+        published = path is not None and not path.exists()
+        if path is not None:
+            _remove(path)
         if not published:
             os.utime(out_dir, ns=(st.st_atime_ns, st.st_mtime_ns))
 
@@ -204,11 +216,12 @@ def commit(staged: Path, out_dir: Path, robot: str) -> bool:
     if kit.is_dir() and not kit.is_symlink():
         reuse.keep_folder_times(staged / kit.name, kit)
     (staged / _INODE).write_text(str((staged / kit.name).stat().st_ino))
-    os.rename(staged, out_dir / manifest.journal_name(robot))
-    step("journaled")
-    _roll_forward(out_dir, robot)
-    clean(out_dir, robot)
-    step("cleaned")
+    with interrupt.held():  # once journaled, a signal waits for the publish to complete
+        os.rename(staged, out_dir / manifest.journal_name(robot))
+        step("journaled")
+        _roll_forward(out_dir, robot)
+        clean(out_dir, robot)
+        step("cleaned")
     return True
 
 
@@ -293,16 +306,17 @@ def swap_folder(staged: Path, final: Path) -> None:
     leaves the old folder or the new one, whole. Without it, the old folder is moved aside
     first and `recover_folder` puts it back if a kill comes between the two renames."""
     step("site_staged")
-    if not final.exists():
-        os.rename(staged, final)
-    elif _exchange(staged, final):
-        step("site_swapped")
-        _remove(staged)  # now the old folder
-    else:
-        old = final.with_name(f".{final.name}.old")
-        _remove(old)
-        os.rename(final, old)
-        step("site_moved_aside")
-        os.rename(staged, final)
-        step("site_swapped")
-        _remove(old)
+    with interrupt.held():  # a signal waits for the swap to complete
+        if not final.exists():
+            os.rename(staged, final)
+        elif _exchange(staged, final):
+            step("site_swapped")
+            _remove(staged)  # now the old folder
+        else:
+            old = final.with_name(f".{final.name}.old")
+            _remove(old)
+            os.rename(final, old)
+            step("site_moved_aside")
+            os.rename(staged, final)
+            step("site_swapped")
+            _remove(old)

@@ -13,6 +13,11 @@ The child's result comes back pickled through a pipe. Where there is no `os.fork
 `SIMKIT_NO_FORK=1`, or where the child ends without a result (an exception, a signal), the
 work runs in-process when its result is asked for: the same deterministic function, so the
 bytes are the same and an error surfaces exactly as it would without the fork.
+
+Children take the default signal dispositions (`interrupt.in_child`; signals are blocked
+across the fork so none reaches a child still holding the parent's handler): a signal ends
+a child at once. When the parent is interrupted (SIGTERM, SIGINT), its `finally` blocks
+(`run_all`, `warm_worker`) kill and reap every child, so none outlives it.
 """
 
 from __future__ import annotations
@@ -21,10 +26,13 @@ import contextlib
 import importlib
 import os
 import pickle
+import signal
 import struct
 import warnings
 from collections.abc import Callable, Iterator
 from typing import BinaryIO, Generic, TypeVar
+
+from simkit.kitio import interrupt
 
 T = TypeVar("T")
 
@@ -60,7 +68,7 @@ class Background(Generic[T]):
             # Python 3.12+ warns on fork in a process with threads. Ours are idle BLAS pools;
             # the child runs only `work` and leaves with os._exit, never through Python exit.
             warnings.simplefilter("ignore", DeprecationWarning)
-            pid = os.fork()
+            pid = _fork()
         if pid == 0:  # the child
             os.close(read_fd)
             _child(self._work, write_fd)
@@ -102,6 +110,19 @@ class Background(Generic[T]):
         with contextlib.suppress(ChildProcessError):
             os.waitpid(self._pid, 0)
         self._pid = 0
+
+
+def _fork() -> int:
+    """`os.fork` with the interrupting signals blocked across it; the child takes the
+    default dispositions before they are unblocked (see the module docstring)."""
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, interrupt.SIGNALS)
+    try:
+        pid = os.fork()
+        if pid == 0:
+            interrupt.in_child()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+    return pid
 
 
 def _child(work: Callable[[], object], write_fd: int) -> None:
@@ -161,7 +182,7 @@ class Worker:
         result_read, result_write = os.pipe()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)  # see Background._fork
-            pid = os.fork()
+            pid = _fork()
         if pid == 0:
             os.close(job_write)
             os.close(result_read)
