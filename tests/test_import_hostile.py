@@ -134,11 +134,9 @@ def test_names_with_a_newline_cannot_inject_yaml(tmp_path):
 def test_a_folder_left_by_a_killed_import_is_removed_by_the_next(tmp_path):
     urdf = _write(tmp_path, _link("base"), _link("arm"), _joint("j", "base", "arm"))
     out = tmp_path / "out"
-    code = (
-        "import sys; from pathlib import Path; from simkit.importer import import_robot; "
-        "import_robot(Path(sys.argv[1]), Path(sys.argv[2]))"
-    )
-    child = subprocess.Popen([sys.executable, "-c", code, str(urdf), str(out)])
+    # the command line turns SIGTERM into the normal clean-up (kitio/interrupt.py)
+    cmd = [sys.executable, "-m", "simkit.cli", "import", str(urdf), "--out", str(out), "-q"]
+    child = subprocess.Popen(cmd, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
     while not list(out.glob(".import-*")) and child.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)
@@ -157,11 +155,9 @@ def test_sigterm_removes_the_staging_folder(tmp_path):
         body += [_link(f"l{k}"), _joint(f"j{k}", f"l{k - 1}", f"l{k}", 0.05)]
     urdf = _write(tmp_path, *body)
     out = tmp_path / "out"
-    code = (
-        "import sys; from pathlib import Path; from simkit.importer import import_robot; "
-        "import_robot(Path(sys.argv[1]), Path(sys.argv[2]))"
-    )
-    child = subprocess.Popen([sys.executable, "-c", code, str(urdf), str(out)])
+    # the command line turns SIGTERM into the normal clean-up (kitio/interrupt.py)
+    cmd = [sys.executable, "-m", "simkit.cli", "import", str(urdf), "--out", str(out), "-q"]
+    child = subprocess.Popen(cmd, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
     while not list(out.glob(".import-*")) and child.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)

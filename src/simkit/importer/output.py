@@ -17,13 +17,12 @@ import errno
 import os
 import re
 import shutil
-import signal
 import tempfile
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 
 from simkit.errors import SimkitError
+from simkit.kitio import interrupt
 
 PREFIX = ".import-"
 #: errors of the disk or of permissions, reported as one line naming the path
@@ -69,36 +68,18 @@ def remove_stale(out_dir: Path) -> None:
 
 
 @contextlib.contextmanager
-def _terminated_as_interrupt() -> Iterator[None]:
-    """SIGTERM raises KeyboardInterrupt (as SIGINT does) while the import runs, so the
-    staging folder's clean-up runs on both."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def stop(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    previous = signal.signal(signal.SIGTERM, stop)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
-@contextlib.contextmanager
 def staging(out_dir: Path) -> Iterator[Path]:
     """A fresh staging folder inside `out_dir` (created if needed), removed on exit; disk
     and permission errors inside become one line naming the path."""
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         remove_stale(out_dir)
-        tmp = Path(tempfile.mkdtemp(dir=out_dir, prefix=f"{PREFIX}{os.getpid()}-"))
+        with interrupt.held():  # a signal here takes effect once `tmp` is known
+            tmp = Path(tempfile.mkdtemp(dir=out_dir, prefix=f"{PREFIX}{os.getpid()}-"))
     except OSError as exc:
         raise unwritable(exc, out_dir) from None
     try:
-        with _terminated_as_interrupt():
-            yield tmp
+        yield tmp  # SIGINT and SIGTERM raise here (kitio/interrupt.py): the finally runs
     except OSError as exc:
         if exc.errno not in DISK_ERRORS:
             raise
