@@ -207,7 +207,7 @@ def test_imported_rigid_quadrotor_rests(tmp_path, kit_factory):
 def test_flying_arm_rests_on_its_frame(tmp_path):
     """A frame with a thin two-link arm hanging below: balanced on the arm's tip it cannot
     rest, so home folds the arm up and the frame carries the weight (the arm's servos do not)."""
-    from simkit.importer.stance import MARGIN, _Support
+    from simkit.importer.stance import MARGIN, Support
     from simkit.model.resolve import resolve
 
     urdf = (
@@ -222,7 +222,7 @@ def test_flying_arm_rests_on_its_frame(tmp_path):
     done = import_robot(_write(tmp_path, urdf), tmp_path / "out", floating=True)
     spec, doc = load_spec(done.spec_path)
     robot = resolve(spec, doc.text.encode(), done.spec_path.name)
-    support = _Support(robot, done.spec_path.parent)
+    support = Support(robot, done.spec_path.parent)
     assert support.margin([0.0, 0.0]) < MARGIN  # the first guess stands on the arm's tip
     home = spec.poses["home"]
     assert home != (0.0, 0.0) and support.margin(home, frame_only=True) >= MARGIN

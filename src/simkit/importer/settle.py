@@ -85,8 +85,8 @@ def _principal(tensor) -> dict[str, str]:
 
 def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Element:
     """A body with the link's real inertial and its collision shapes (floor contact only)."""
-    from simkit.importer.home import _geom
-    from simkit.importer.stance import _shapes
+    from simkit.importer.collide import geom
+    from simkit.importer.stance import stance_shapes
 
     body = ET.SubElement(parent, "body", name=link.name, **attrs)
     inertial = link.inertial
@@ -100,8 +100,8 @@ def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Elemen
         )
     else:  # a massless link: a speck, so MuJoCo accepts a moving body
         ET.SubElement(body, "inertial", pos="0 0 0", mass="1e-6", diaginertia="1e-9 1e-9 1e-9")
-    for i, shape in enumerate(_shapes(link)):
-        _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+    for i, shape in enumerate(stance_shapes(link)):
+        geom(asset, body, shape, base_dir, f"{link.name}_{i}")
     return body
 
 
@@ -187,29 +187,29 @@ class Settler:
     def __init__(self, robot, base_dir: Path, home, follow):
         import mujoco
 
-        from simkit.importer.home import _always_touching
-        from simkit.importer.stance import _shapes, _Support
+        from simkit.importer.collide import always_touching
+        from simkit.importer.stance import Support, stance_shapes
 
         home = np.asarray(home, dtype=float)
         self.robot, self.base_dir, self.follow = robot, base_dir, follow
-        self.excluded = _always_touching(robot, base_dir, home, follow, _shapes)
+        self.excluded = always_touching(robot, base_dir, home, follow, stance_shapes)
         self.model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, home, self.excluded))
         joint = lambda name: self.model.jnt_qposadr[self.model.joint(name).id]  # noqa: E731
         self.adr = np.array([joint(j.name) for j in robot.movable_joints], dtype=int)
         self.servos = _servos(robot)
         self.servo_adr = np.array([joint(j.name) for j in self.servos], dtype=int)
-        self.frame = _Support(robot, base_dir).frame
+        self.frame = Support(robot, base_dir).frame
         self.free = self.model.jnt_qposadr[self.model.joint(robot.floating_joint.name).id]
 
     def height(self, q) -> float:
         """m the base's origin stands above the floor at `q`, the base at its rotation."""
-        from simkit.importer.standing import _lowest, floor_shapes
+        from simkit.importer.standing import floor_shapes, lowest
         from simkit.model.kinematics import forward
 
         poses = forward(self.robot, list(q))
         base = poses[self.robot.floating_joint.child][2, 3]
         low = [
-            _lowest(shape, poses[link.name], self.base_dir)
+            lowest(shape, poses[link.name], self.base_dir)
             for link in self.robot.links
             for shape in floor_shapes(link)
         ]
@@ -258,7 +258,7 @@ class Settler:
 
         robot = self.robot
         movable = robot.movable_joints
-        model = mujoco.MjModel.from_xml_string(stance._model_xml(robot, self.base_dir))
+        model = mujoco.MjModel.from_xml_string(stance.model_xml(robot, self.base_dir))
         data = mujoco.MjData(model)
         adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
         lo = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
@@ -270,7 +270,7 @@ class Settler:
             for q in (self.follow(d) for d in draws)
             if all(
                 p in self.excluded or depth <= stance.TOUCH
-                for p, depth in stance._contacts(model, data, adr, q).items()
+                for p, depth in stance.contacts(model, data, adr, q).items()
             )
         ]
         home = np.asarray(home, dtype=float)
@@ -286,17 +286,17 @@ def _rpy(quat) -> tuple[float, float, float]:
     return tuple(float(v) for v in Rotation.from_quat([x, y, z, w]).as_euler("xyz"))
 
 
-def rest_pose(spec_path: Path) -> tuple[list[float], Rest, str] | None:
+def rest_pose(robot, base_dir: Path) -> tuple[list[float], Rest, str] | None:
     """Where a robot that tips onto its frame at home comes to rest: home where its servos
     hold that rest within LIMIT, else the seeded candidate pose (Settler.candidates) whose
     rest needs the least of any servo's effort; the pose, its rest and one report line.
     None where the robot stands level at home (legs), or no candidate rests within LIMIT."""
-    from simkit.importer.home import load
+    from simkit.importer.collide import posed
 
-    robot, home, follow = load(spec_path)
+    home, follow = posed(robot)
     if robot.floating_joint is None or home is None or not _servos(robot):
         return None
-    settler = Settler(robot, spec_path.parent, home, follow)
+    settler = Settler(robot, base_dir, home, follow)
     first = settler.run(home)
     if first.tilt <= TILT or not first.frame_down:  # level on its feet: standing.py's stance
         return None

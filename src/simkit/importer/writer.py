@@ -50,3 +50,43 @@ def check(path: Path) -> None:
     from simkit.spec.validate import load_spec
 
     load_spec(path, display=str(path))
+
+
+def finish(draft, out_dir: Path) -> Path:
+    """Write the draft's spec once, validate it once (`check`), and copy it with its meshes
+    from the staging folder into `out_dir`; a mesh the spec written there before used and
+    this one does not is removed (no stale meshes). Returns the spec's path in `out_dir`."""
+    import shutil
+
+    name = draft.spec["name"]
+    staged = draft.stage / f"{name}.yaml"
+    staged.write_text(spec_yaml(draft.spec, draft.report.lines, draft.path), encoding="utf-8")
+    check(staged)
+    target = out_dir / f"{name}.yaml"
+    new = {item.relative_to(draft.stage) for item in draft.stage.rglob("*") if item.is_file()}
+    others = set().union(*(_meshes_of(p) for p in out_dir.glob("*.yaml") if p != target))
+    for old in sorted(_meshes_of(target) - new - others):  # another spec's stay
+        (out_dir / old).unlink(missing_ok=True)
+    for rel in sorted(new):
+        (out_dir / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(draft.stage / rel, out_dir / rel)
+    return target
+
+
+def _meshes_of(spec_path: Path) -> set[Path]:
+    """The relative mesh files an earlier spec at `spec_path` names (none if unreadable)."""
+    try:
+        spec = yaml.safe_load(spec_path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError, UnicodeDecodeError):
+        return set()
+    out: set[Path] = set()
+    links = spec.get("links") if isinstance(spec, dict) else None
+    for link in links if isinstance(links, list) else []:
+        for key in ("solid", "collision_shapes", "collision_primitives"):
+            shapes = link.get(key) if isinstance(link, dict) else None
+            for shape in shapes if isinstance(shapes, list) else []:
+                if isinstance(shape, dict) and isinstance(shape.get("file"), str):
+                    rel = Path(shape["file"])
+                    if not rel.is_absolute() and ".." not in rel.parts:
+                        out.add(rel)
+    return out
