@@ -229,7 +229,7 @@ def diff_kits(old: Path, new: Path) -> Report:
     return diff_files(load_kit(old), load_kit(new), str(old), str(new))
 
 
-def _value(value, unit: str, field_name: str) -> str:
+def value_text(value, unit: str, field_name: str) -> str:
     if value is None:
         return "-"
     if isinstance(value, (bool, str)):
@@ -242,7 +242,7 @@ def _value(value, unit: str, field_name: str) -> str:
     return f"({', '.join(num(v, 6) for v in value)}) {unit}".rstrip()
 
 
-def _delta(change: Change) -> str:
+def delta_text(change: Change) -> str:
     a, b = change.old, change.new
     if isinstance(a, bool) or isinstance(b, bool):
         return ""
@@ -290,8 +290,8 @@ def to_markdown(report: Report) -> str:
         elif modified:
             lines += ["| name | field | old | new | change |", "|---|---|---|---|---|"]
             lines += [
-                f"| `{c.name}` | {c.field} | {_value(c.old, c.unit, c.field)} | "
-                f"{_value(c.new, c.unit, c.field)} | {_delta(c)} |"
+                f"| `{c.name}` | {c.field} | {value_text(c.old, c.unit, c.field)} | "
+                f"{value_text(c.new, c.unit, c.field)} | {delta_text(c)} |"
                 for c in modified
             ]
         lines.append("")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.diff import TITLES, Change, Report, _delta, _value
+from simkit.diff import TITLES, Change, Report, delta_text, value_text
 from simkit.review.png import png_bytes, read_png
 from simkit.review.progress import Reporter
 from simkit.review.render import DEFAULT_SIZE, Item, kit_poses, run_job
@@ -138,9 +138,9 @@ def _changes_html(changes: Sequence[Change]) -> list[str]:
                 cells = [
                     c.name,
                     c.field,
-                    _value(c.old, c.unit, c.field),
-                    _value(c.new, c.unit, c.field),
-                    _delta(c),
+                    value_text(c.old, c.unit, c.field),
+                    value_text(c.new, c.unit, c.field),
+                    delta_text(c),
                 ]
             rows.append(
                 "<tr>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in cells) + "</tr>"
