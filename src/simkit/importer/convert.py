@@ -137,6 +137,8 @@ def convert(
             js = joint_spec(source, joint, report, (0.0, 0.1))
             frame = {"name": link_name, "parent": js["parent"]}
             frame.update({k: js[k] for k in ("xyz", "rpy") if k in js})
+            if js["name"] != f"{link_name}_joint":  # the URDF's own joint name, kept
+                frame["joint"] = js["name"]
             spec_frames.append(frame)
             continue
         spec_links.append(
