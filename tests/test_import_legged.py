@@ -88,7 +88,7 @@ def test_always_touching_pairs_are_found(tmp_path):
         + _joint("shoulder", "body", "arm", "0 0.2 0", "1 0 0", "3")
         + "</robot>"
     )
-    done = import_robot(_write(tmp_path, urdf), tmp_path / "out")
+    done = import_robot(_write(tmp_path, urdf), tmp_path / "out", floating=False)  # bolted
     text = done.spec_path.read_text()
     spec, _doc = load_spec(done.spec_path)
     robot = resolve(spec, text.encode(), done.spec_path.name)
@@ -105,7 +105,7 @@ def test_floating_urdf_without_collision_collides_with_its_visuals(tmp_path):
     links = yaml.safe_load(done.spec_path.read_text())["links"]
     assert all(link["collision"] == "mesh" and "collision" in link["estimated"] for link in links)
     assert any("no <collision> in the URDF" in line for line in done.lines)
-    fixed = import_robot(path, tmp_path / "fixed")
+    fixed = import_robot(path, tmp_path / "fixed", floating=False)
     links = yaml.safe_load(fixed.spec_path.read_text())["links"]
     assert all(link["collision"] == "primitives" for link in links)  # as the URDF says
 

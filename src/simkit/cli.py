@@ -257,6 +257,11 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
 @click.option("--strict", is_flag=True, help="Refuse instead of estimating missing values.")
 @click.option("--floating-base", is_flag=True, help="The root link moves freely (legged).")
 @click.option(
+    "--fixed-base",
+    is_flag=True,
+    help="The root link is bolted to the world. [default: decided from the robot's limbs]",
+)
+@click.option(
     "--hull",
     "hull_collision",
     is_flag=True,
@@ -270,6 +275,7 @@ def import_urdf(
     package_dirs: tuple[Path, ...],
     strict: bool,
     floating_base: bool,
+    fixed_base: bool,
     hull_collision: bool,
     out_dir: Path,
     quiet: bool,
@@ -277,9 +283,18 @@ def import_urdf(
     """Turn a URDF or xacro into OUT/NAME.yaml plus the meshes it needs."""
     from simkit.importer import import_robot
 
+    if floating_base and fixed_base:
+        raise click.UsageError("--floating-base and --fixed-base exclude each other")
+    floating = True if floating_base else False if fixed_base else None
     try:
         done = import_robot(
-            path, out_dir, name, package_dirs, strict, floating_base, hull_collision
+            path,
+            out_dir,
+            name=name,
+            package_dirs=package_dirs,
+            strict=strict,
+            floating=floating,
+            hull_collision=hull_collision,
         )
     except SimkitError as exc:
         _fail(exc)

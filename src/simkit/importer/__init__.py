@@ -75,13 +75,14 @@ def import_robot(
     name: str | None = None,
     package_dirs: tuple[Path, ...] = (),
     strict: bool = False,
-    floating: bool = False,
+    floating: bool | None = None,
     hull_collision: bool = False,
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
-    `hull_collision`: links whose URDF collision has meshes collide with their visual
-    solid's convex hull instead (one piece; reported per link)."""
-    from simkit.importer import fixups, source, writer
+    `floating`: True or False sets the base; None decides it from the robot's structure
+    (base.py; reported). `hull_collision`: links whose URDF collision has meshes collide
+    with their visual solid's convex hull instead (one piece; reported per link)."""
+    from simkit.importer import base, fixups, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
@@ -90,6 +91,9 @@ def import_robot(
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
         draft = Draft(doc, path, Path(tmp), Report(strict=strict))
+        if floating is None:
+            floating, why = base.decide(doc)
+            draft.report.assumed(doc, doc.root, why)
         meshes = translate(draft, name, floating, hull_collision)
         for step in fixups.STEPS:
             step(draft)

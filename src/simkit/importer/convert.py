@@ -17,7 +17,7 @@ from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 TOP = ("link", "joint", "material")
 
 
-def _tree(source: Source) -> tuple[dict, dict, str]:
+def tree(source: Source) -> tuple[dict, dict, str]:
     """Links by name, joints by child, and the root link; errors for cycles and orphans."""
     links: dict = {}
     for link in source.root.findall("link"):
@@ -117,7 +117,7 @@ def convert(
             report.dropped(
                 source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
             )
-    links, by_child, root = _tree(source)
+    links, by_child, root = tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)
     materials, colours = materials_of(source), {}
