@@ -262,6 +262,12 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
     help="The root link is bolted to the world. [default: decided from the robot's limbs]",
 )
 @click.option(
+    "--density",
+    type=click.FloatRange(min=1.0, max=25000.0),
+    default=None,
+    help="kg/m^3 of a massless link's visual solid, for its estimated mass. [default: 2700]",
+)
+@click.option(
     "--hull",
     "hull_collision",
     is_flag=True,
@@ -276,6 +282,7 @@ def import_urdf(
     strict: bool,
     floating_base: bool,
     fixed_base: bool,
+    density: float | None,
     hull_collision: bool,
     out_dir: Path,
     quiet: bool,
@@ -295,6 +302,7 @@ def import_urdf(
             strict=strict,
             floating=floating,
             hull_collision=hull_collision,
+            density=density,
         )
     except SimkitError as exc:
         _fail(exc)

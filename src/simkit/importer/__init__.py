@@ -7,7 +7,7 @@ written only when the whole import succeeded.
 
 The import is one in-memory draft (draft.py) passed through explicit, ordered steps:
 `translate` (the URDF to a spec dict: convert.py, names.py, blocks.py), then the pose
-fix-ups (fixups.STEPS: base, home, stand, limits), then `writer.finish`, which writes and
+fix-ups (fixups.STEPS: rotors, base, home, stand, limits), then `writer.finish`, which writes and
 validates the spec once.
 """
 
@@ -40,7 +40,7 @@ def robot_name(path: Path) -> str:
     return name if name[0].isalpha() else f"robot_{name}"
 
 
-def translate(draft: Draft, name: str, floating: bool, hull_collision: bool) -> int:
+def translate(draft: Draft, name: str, floating: bool, hull_collision: bool, density: float) -> int:
     """The URDF to the draft's spec: links, joints, frames and kept blocks, names made legal,
     `--strict` problems refused, the STEP left out when the meshes are too large. Returns
     the number of meshes written to the staging folder."""
@@ -53,7 +53,7 @@ def translate(draft: Draft, name: str, floating: bool, hull_collision: bool) -> 
     mesh_writer.turn_y_up, why = turn_y_up(source)  # Y_UP COLLADA meshes drawn so: turned
     if why:
         report.changed(source, source.root, why)
-    spec = convert.convert(source, name, mesh_writer, report, floating, hull_collision)
+    spec = convert.convert(source, name, mesh_writer, report, floating, hull_collision, density)
     renames = names.make_legal(spec, source, report)
     blocks.keep(spec, source, report, blocks.collect(source), renames)
     if report.strict and report.problems:
@@ -77,12 +77,14 @@ def import_robot(
     strict: bool = False,
     floating: bool | None = None,
     hull_collision: bool = False,
+    density: float | None = None,
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `floating`: True or False sets the base; None decides it from the robot's structure
     (base.py; reported). `hull_collision`: links whose URDF collision has meshes collide
-    with their visual solid's convex hull instead (one piece; reported per link)."""
-    from simkit.importer import base, fixups, source, writer
+    with their visual solid's convex hull instead (one piece; reported per link).
+    `density` (kg/m^3, default masses.DENSITY): a massless link's mass from its solid."""
+    from simkit.importer import base, fixups, masses, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
@@ -94,7 +96,7 @@ def import_robot(
         if floating is None:
             floating, why = base.decide(doc)
             draft.report.assumed(doc, doc.root, why)
-        meshes = translate(draft, name, floating, hull_collision)
+        meshes = translate(draft, name, floating, hull_collision, density or masses.DENSITY)
         for step in fixups.STEPS:
             step(draft)
         spec_path = writer.finish(draft, out_dir)

@@ -110,8 +110,10 @@ def convert(
     report: Report,
     floating: bool,
     hull_collision: bool = False,
+    density: float | None = None,
 ) -> dict:
-    """The spec dict for the whole robot."""
+    """The spec dict for the whole robot. `density` (kg/m^3): massless links with a solid
+    get its mass at it (`_estimated_mass`; None: the placeholder speck)."""
     for element in source.root:
         if isinstance(element.tag, str) and element.tag not in TOP + URDF_BLOCK_TAGS:
             report.dropped(
@@ -141,8 +143,18 @@ def convert(
                 frame["joint"] = js["name"]
             spec_frames.append(frame)
             continue
+        estimate = density if _estimated_mass(link_name, links, by_child) else None
         spec_links.append(
-            link_spec(source, links[link_name], writer, report, materials, colours, hull_collision)
+            link_spec(
+                source,
+                links[link_name],
+                writer,
+                report,
+                materials,
+                colours,
+                hull_collision,
+                estimate,
+            )
         )
         if link_name in by_child:
             load = _load(source, link_name, links, kids, by_child)
@@ -188,6 +200,17 @@ def convert(
     if spec_frames:
         spec["frames"] = spec_frames
     return spec
+
+
+def _estimated_mass(name: str, links: dict, by_child: dict) -> bool:
+    """Whether a massless link's mass comes from its solid (masses.py): always where the URDF
+    gives no link a mass, else for a link on a movable joint (a massless link on a fixed
+    joint is the author's frame or housing, merged into its parent)."""
+    if has_mass(links[name]):
+        return False
+    if not any(has_mass(link) for link in links.values()):
+        return True
+    return name in by_child and by_child[name].get("type") not in ("fixed", None)
 
 
 def _visual_collision(source: Source, spec_links: list[dict], report: Report) -> None:

@@ -1,9 +1,11 @@
-"""The pose fix-ups an import applies to its draft after translating the URDF, in order.
+"""The fix-ups an import applies to its draft after translating the URDF, in order.
 
 Each step reads the draft's resolved robot, changes the draft only where it must (the URDF's
 zero pose is kept unless links collide, a servo cannot hold it, or a floating base needs a
 place to stand), and gives each change one report line with its reason:
 
+0. `rotors`: each driven joint's estimated rotor inertia (armature), bounded by what the
+   joint moves (masses.py).
 1. `base`: a floating robot drawn Y-up is turned to stand on its limbs (upright.py).
 2. `home`: out of self-contact: any joint between touching links may move for a fixed base
    (home.py), then to where the servos hold it against gravity (gravity.py); a floating
@@ -119,5 +121,12 @@ def limits(draft: Draft) -> None:
     draft.changed()
 
 
-#: the pose fix-ups, in the order they run
-STEPS = (base, home, stand, limits)
+def rotors(draft: Draft) -> None:
+    """Estimated armature per driven joint (masses.armature)."""
+    from simkit.importer.masses import armature
+
+    armature(draft)
+
+
+#: the fix-ups, in the order they run
+STEPS = (rotors, base, home, stand, limits)
