@@ -150,14 +150,28 @@ def test_open_mesh_hull_is_a_solid_at_stl_precision():
     assert _is_solid(back.vertices, back.faces)
 
 
-def test_corpus_script_imports_arms_fixed():
+def test_corpus_script_takes_any_folder_with_default_flags(tmp_path):
+    """scripts/import_corpus.py: any folder, --exclude globs, --movable-only; no robot
+    lists; a refusal keeps the invariant only as one line naming the URDF."""
     spec = importlib.util.spec_from_file_location("corpus", REPO / "scripts" / "import_corpus.py")
     corpus = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(corpus)
-    assert corpus.floating(Path("talos_data/robots/talos_reduced.urdf"))
-    assert not corpus.floating(Path("talos_data/robots/talos_left_arm.urdf"))
-    assert not corpus.floating(Path("alex_description/urdf/alex_nub_hands.urdf"))
-    assert corpus.floating(Path("g1_description/urdf/g1_29dof_rev_1_0.urdf"))
+    moving = '<robot name="a"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+    moving += '<parent link="a"/><child link="b"/></joint></robot>'
+    (tmp_path / "arm").mkdir()
+    (tmp_path / "arm" / "arm.urdf").write_text(moving)
+    (tmp_path / "random_urdfs").mkdir()
+    (tmp_path / "random_urdfs" / "x.urdf").write_text(moving)
+    (tmp_path / "block.urdf").write_text('<robot name="b"><link name="b"/></robot>')
+    found = corpus.urdfs(tmp_path, ["random_urdfs/*"], movable_only=True)
+    assert [p.relative_to(tmp_path).as_posix() for p in found] == ["arm/arm.urdf"]
+    assert len(corpus.urdfs(tmp_path, [], movable_only=False)) == 3
+    assert corpus._name(Path("talos_data/robots/talos-full.v2.urdf")) == "robots_talos_full"
+    urdf = tmp_path / "arm" / "arm.urdf"
+    assert corpus._refusal(urdf, "simkit: error: arm.urdf:3: joint[j]: bad\n") == ""
+    assert corpus._refusal(urdf, "Traceback (most recent call last):\n  x\n") == "traceback"
+    assert corpus._refusal(urdf, "simkit: error: /tmp/x.yaml: bad\n") != ""
+    assert not hasattr(corpus, "FLOATING")
 
 
 def _walker() -> str:

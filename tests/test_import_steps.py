@@ -79,3 +79,110 @@ def test_reimport_is_byte_identical_and_leaves_no_stale_mesh(tmp_path):
     import_robot(ARM, tmp_path / "out")
     again = {p: p.read_bytes() for p in (tmp_path / "out").rglob("*") if p.is_file()}
     assert again == files
+
+
+def _biped(fold: bool = False) -> str:
+    """A pelvis with two legs hanging 0.5 m below it and two arms; `fold`: the hands hang
+    inside the thighs at the zero pose (a humanoid's arms through its legs)."""
+    arm_y = "0.1" if fold else "0.25"
+    body = box("pelvis", "0.3 0.3 0.1", mass=5.0)
+    for side, y in (("l", ""), ("r", "-")):
+        body += box(f"{side}_thigh", "0.08 0.08 0.5", "0 0 -0.25", 2.0)
+        body += joint(f"{side}_hip", "revolute", "pelvis", f"{side}_thigh", f"0 {y}0.1 -0.05")
+        body += box(f"{side}_arm", "0.04 0.04 0.4", "0 0 -0.2", 0.5)
+        body += joint(f"{side}_shoulder", "revolute", "pelvis", f"{side}_arm",
+                      f"0 {y}{arm_y} 0.05", axis="1 0 0", lower=-1.5, upper=1.5)  # fmt: skip
+    return body
+
+
+def _arm() -> str:
+    body = box("base", "0.1 0.1 0.1", "0 0 0.05", 2.0)
+    body += box("upper", "0.05 0.05 0.3", "0 0 0.15", 1.0)
+    body += box("fore", "0.04 0.04 0.3", "0 0 0.15", 0.5)
+    body += joint("shoulder", "revolute", "base", "upper", "0 0 0.1")
+    body += joint("elbow", "revolute", "upper", "fore", "0 0 0.3")
+    return body
+
+
+def test_legs_make_a_floating_base_and_an_arm_a_fixed_one(tmp_path):
+    biped = import_robot(write(tmp_path, _biped(), "biped"), tmp_path / "biped")
+    spec = yaml.safe_load(biped.spec_path.read_text())
+    assert spec.get("floating_base") and spec["joints"][0]["type"] == "floating"
+    assert any("floating base: 4 limbs reach" in line for line in biped.lines)  # arms too
+    arm = import_robot(write(tmp_path, _arm(), "arm"), tmp_path / "arm")
+    spec = yaml.safe_load(arm.spec_path.read_text())
+    assert not spec.get("floating_base") and spec["joints"][0]["type"] == "fixed"
+    assert any("fixed base: the root link 'base'" in line for line in arm.lines)
+    bolted = import_robot(write(tmp_path, _biped(), "biped"), tmp_path / "bolted", floating=False)
+    spec = yaml.safe_load(bolted.spec_path.read_text())
+    assert spec["joints"][0]["type"] == "fixed"
+    assert not any("floating base:" in line or "fixed base:" in line for line in bolted.lines)
+
+
+def test_cli_base_flags_override_and_exclude_each_other(tmp_path):
+    from click.testing import CliRunner
+
+    from simkit.cli import main
+
+    path = write(tmp_path, _biped(), "biped")
+    result = CliRunner().invoke(main, ["import", str(path), "--out", str(tmp_path / "a"),
+                                       "--fixed-base", "-q"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert yaml.safe_load((tmp_path / "a" / "biped.yaml").read_text())["joints"][0]["type"] == (
+        "fixed"
+    )
+    both = CliRunner().invoke(main, ["import", str(path), "--out", str(tmp_path / "b"),
+                                     "--fixed-base", "--floating-base"])  # fmt: skip
+    assert both.exit_code != 0 and "exclude each other" in both.output
+
+
+def test_legged_robot_bolted_at_the_pelvis_gets_a_home_free_of_contact(tmp_path):
+    """--fixed-base on a humanoid whose hands hang inside its thighs: the home search moves
+    the arms out (and keeps the legs as they hang), reported."""
+    import mujoco
+    import numpy as np
+
+    from simkit.importer import collide
+    from simkit.model.resolve import resolve
+    from simkit.spec.validate import load_spec
+
+    path = write(tmp_path, _biped(fold=True), "folded")
+    done = import_robot(path, tmp_path / "out", floating=False)
+    spec, doc = load_spec(done.spec_path)
+    home = dict(spec.poses)["home"]
+    names = [j.name for j in spec.joints if j.type == "revolute"]
+    moved = {n for n, v in zip(names, home, strict=True) if v != 0.0}
+    assert moved and moved <= {"l_shoulder", "r_shoulder"}
+    assert any("home: the links collide" in line for line in done.lines)
+    robot = resolve(spec, doc.text.encode(), done.spec_path.name)
+    xml = collide.model_xml(robot, done.spec_path.parent, (), collide.covered_shapes)
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    adr = [model.jnt_qposadr[model.joint(n).id] for n in names]
+    collide.penetration(model, data, np.array(adr), np.array(home))
+    assert not collide.touching(data)
+
+
+def test_fixed_joint_names_are_kept(tmp_path):
+    """A massless leaf on a fixed joint becomes a frame that keeps the URDF joint's name,
+    `-` and all (the kit's URDF writes it); only a name the kit cannot hold is renamed."""
+    body = _arm() + '<link name="tool0"/>'
+    body += '<joint name="fore-tool0_fixed_joint" type="fixed"><parent link="fore"/>'
+    body += '<child link="tool0"/><origin xyz="0 0 0.3"/></joint>'
+    body += '<link name="cam"/><joint name="cam joint" type="fixed"><parent link="fore"/>'
+    body += '<child link="cam"/></joint>'
+    done = import_robot(write(tmp_path, body, "tool"), tmp_path / "out")
+    spec = yaml.safe_load(done.spec_path.read_text())
+    frames = {f["name"]: f for f in spec["frames"]}
+    assert frames["tool0"]["joint"] == "fore-tool0_fixed_joint"
+    assert frames["cam"]["joint"] == "cam_joint"  # a space: renamed, reported
+    assert any("'cam_joint'" in line and "renamed" in line for line in done.lines)
+    assert not any("fore-tool0" in line for line in done.lines)
+    from simkit.emit import urdf
+    from simkit.model.resolve import resolve
+    from simkit.spec.validate import load_spec
+
+    loaded, doc = load_spec(done.spec_path)
+    robot = resolve(loaded, doc.text.encode(), done.spec_path.name)
+    text = b"".join(urdf.emit(robot).values()).decode()
+    assert '<joint name="fore-tool0_fixed_joint" type="fixed">' in text

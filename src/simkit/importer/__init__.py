@@ -93,8 +93,9 @@ def import_robot(
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
         draft = Draft(doc, path, Path(tmp), Report(strict=strict))
+        draft.legged, why = base.decide(doc)
         if floating is None:
-            floating, why = base.decide(doc)
+            floating = draft.legged
             draft.report.assumed(doc, doc.root, why)
         meshes = translate(draft, name, floating, hull_collision, density or masses.DENSITY)
         for step in fixups.STEPS:

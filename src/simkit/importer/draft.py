@@ -29,6 +29,8 @@ class Draft:
     spec: dict = field(default_factory=dict)
     #: the resolved model of `spec`, or None after a change (resolved again on demand)
     resolved: object | None = None
+    #: legs hang from the root (base.decide), whether or not the base floats
+    legged: bool = False
 
     def robot(self):
         """The draft as simkit's model (model/resolve.py): schema-checked, not yet

@@ -46,10 +46,39 @@ def home(draft: Draft) -> None:
         draft.set_home(stance.free_home(draft.robot(), draft.stage), why)
         return
     why = "the links collide at the first guess (0, or mid-range outside the limits)"
-    draft.set_home(free.free_home(draft.robot(), draft.stage), why)
+    if draft.legged:  # bolted at the pelvis: the legs hang as they are, the arms move
+        found = _bolted_home(draft) if free.in_contact(draft.robot(), draft.stage) else None
+    else:
+        found = free.free_home(draft.robot(), draft.stage)
+        if found is None and free.in_contact(draft.robot(), draft.stage):
+            found = _bolted_home(draft)
+    draft.set_home(found, why)
     held = gravity.held_home(draft.robot(), draft.stage)
     if held is not None:
         draft.set_home(held[:2], held[2])
+
+
+def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:
+    """Where one joint at a time cannot part the links (a humanoid bolted at the pelvis, its
+    hands inside its thighs): the stance search with the legs kept as they hang (stance.py),
+    then home.py's clearance search from there; the changes from the first guess."""
+    from simkit.importer import home as free
+    from simkit.importer import stance
+
+    found = stance.free_home(draft.robot(), draft.stage, rest=False)
+    if found is None:
+        return None
+    first = list(draft.spec["poses"]["home"])
+    draft.spec["poses"]["home"] = found[0]
+    draft.changed()
+    polished = free.free_home(draft.robot(), draft.stage)
+    pose = polished[0] if polished is not None else found[0]
+    draft.spec["poses"]["home"] = first
+    draft.changed()
+    names = [j["name"] for j in draft.movable()]
+    moved = zip(names, first, pose, strict=True)
+    changes = [f"{n}: {a:.4g} -> {b:.4g}" for n, a, b in moved if a != b]
+    return (pose, changes) if changes else None
 
 
 def stand(draft: Draft) -> None:

@@ -97,3 +97,20 @@ def _search(robot, base_dir: Path, start: np.ndarray, follow, shapes_of) -> np.n
             break
     penetration(model, data, adr, q)
     return start if touching(data) else q  # no free pose found: the first guess stays
+
+
+def in_contact(robot, base_dir: Path) -> bool:
+    """Whether two links that the kit lets collide touch at the spec's home (the first
+    search's model: collision shapes, the always-touching pairs left out)."""
+    import mujoco
+
+    start, follow = posed(robot)
+    if start is None:
+        return False
+    always = always_touching(robot, base_dir, start, follow, collision_shapes)
+    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, always, collision_shapes))
+    data = mujoco.MjData(model)
+    movable = robot.movable_joints
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    penetration(model, data, adr, start)
+    return touching(data)

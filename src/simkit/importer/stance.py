@@ -232,10 +232,11 @@ def _alike(q, depth, robot, index, movable) -> np.ndarray:
     )
 
 
-def free_home(robot, base_dir: Path) -> tuple[list[float], list[str]] | None:
+def free_home(robot, base_dir: Path, rest: bool = True) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) whose separable link pairs do not touch and on which the
     robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
-    made (`joint: a -> b`); None when home already is, or no grid pose is better."""
+    made (`joint: a -> b`); None when home already is, or no grid pose is better. `rest`
+    False: no floor (a legged robot bolted at its base): free of contact, legs kept."""
     import mujoco
 
     home = dict(robot.poses).get("home")
@@ -288,7 +289,6 @@ def free_home(robot, base_dir: Path) -> tuple[list[float], list[str]] | None:
 
     start = np.array(home, dtype=float)
     q = start
-    support = Support(robot, base_dir)
     if depth(q) > 0.0:
         feet = _feet_joints(robot, home, base_dir)
         q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
@@ -301,7 +301,8 @@ def free_home(robot, base_dir: Path) -> tuple[list[float], list[str]] | None:
             q = start
         elif always:  # "always" here may be "nearly always" to the kit's 10000 samples
             q = search(q, lambda t: (-depth(t), -every(t)), lambda b: b[1] >= 0.0, feet)
-    if support.margin(q) < MARGIN:
+    support = Support(robot, base_dir) if rest else None
+    if support is not None and support.margin(q) < MARGIN:
         q = _resting(q, support, depth, movable, limits, index)
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
