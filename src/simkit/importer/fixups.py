@@ -11,7 +11,8 @@ place to stand), and gives each change one report line with its reason:
    (home.py), then to where the servos hold it against gravity (gravity.py); a floating
    robot keeps its feet and comes to rest on the floor (stance.py).
 3. `stand`: the floating base placed on the floor (standing.py), or where it comes to rest
-   leaning on its frame (settle.py).
+   leaning on its frame (settle.py); a legged robot bolted at its root is raised so that its
+   feet reach the floor.
 4. `limits`: estimated position limits narrowed to the range free of self-contact
    (limits.py).
 """
@@ -71,8 +72,12 @@ def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:
     first = list(draft.spec["poses"]["home"])
     draft.spec["poses"]["home"] = found[0]
     draft.changed()
-    polished = free.free_home(draft.robot(), draft.stage)
-    pose = polished[0] if polished is not None else found[0]
+    pose = found[0]
+    for every in (False, True):  # then pairs the search took for always touching (the kit
+        polished = free.free_home(draft.robot(), draft.stage, every)  # samples more)
+        if polished is not None:
+            pose = draft.spec["poses"]["home"] = polished[0]
+            draft.changed()
     draft.spec["poses"]["home"] = first
     draft.changed()
     names = [j["name"] for j in draft.movable()]
@@ -86,10 +91,20 @@ def stand(draft: Draft) -> None:
     where it comes to rest when it tips onto its frame (a flying arm)."""
     from simkit.importer import standing
 
-    if not draft.floating:
+    if not draft.floating and not draft.legged:
         return
     height = standing.standing_height(draft.robot(), draft.stage)
     if height is None:
+        return
+    if not draft.floating:  # bolted at the pelvis: raised so that its feet reach the floor
+        if height > 0.0:
+            draft.estimate_base(("xyz",), xyz=[0.0, 0.0, float(f"{height:.6f}")])
+            draft.report.changed(
+                draft.source,
+                draft.source.root,
+                f"fixed base bolted {height:.6f} m up: the legs' lowest point at home on the "
+                "floor, as the robot stands",
+            )
         return
     draft.estimate_base(("xyz",), xyz=[0.0, 0.0, float(f"{height:.6f}")])
     draft.report.changed(

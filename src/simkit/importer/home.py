@@ -36,21 +36,21 @@ STEPS = 0.05 * 2.0 ** np.arange(6)
 SWEEPS = 3  # moves per joint at most
 
 
-def free_home(robot, base_dir: Path) -> tuple[list[float], list[str]] | None:
+def free_home(robot, base_dir: Path, every: bool = False) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
     or None when the spec's home is already free or the search finds no free pose. Only the
     joints between two links in contact move, each to the grid value that leaves the least
     penetration, the one nearest the first guess on a tie. A second search, from the first
     one's pose, adds the links' visual pieces (covered_shapes), which the kit's collision pieces
     are grown to cover (Alex's Sake fingers, whose collision meshes sit apart from their
-    visual ones, touch only there)."""
+    visual ones, touch only there). `every`: pairs touching almost everywhere count too."""
 
     start, follow = posed(robot)
     if start is None:  # no movable joint: nothing to move
         return None
     q = start
     for shapes_of in (collision_shapes, covered_shapes):
-        q = _search(robot, base_dir, q, follow, shapes_of)
+        q = _search(robot, base_dir, q, follow, shapes_of, every)
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
         for i, j in enumerate(robot.movable_joints)
@@ -59,14 +59,14 @@ def free_home(robot, base_dir: Path) -> tuple[list[float], list[str]] | None:
     return ([float(f"{v:.6g}") for v in q], changes) if changes else None
 
 
-def _search(robot, base_dir: Path, start: np.ndarray, follow, shapes_of) -> np.ndarray:
+def _search(robot, base_dir: Path, start, follow, shapes_of, every: bool = False) -> np.ndarray:
     """A pose free of contact on the model of `shapes_of`, from `start` (see free_home);
     `start` when it is free already or no free pose is found."""
     import mujoco
 
     movable = robot.movable_joints
     index = {j.name: i for i, j in enumerate(movable)}
-    always = always_touching(robot, base_dir, start, follow, shapes_of)
+    always = () if every else always_touching(robot, base_dir, start, follow, shapes_of)
     model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, always, shapes_of))
     data = mujoco.MjData(model)
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
