@@ -124,6 +124,9 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
     failed = re.search(r"FAIL ([\w.]+)", stderr)
     if rc == 0:
         row["build"] = "ok"
+    elif rc == 124:  # the machine's load, not the invariant: no verdict
+        row["build"] = "timed out"
+        row["reason"] = stderr
     elif failed:  # built and compiled; a check failed
         row["build"] = "check failed"
         row["reason"] = " ".join(stderr.split())[stderr.find("FAIL") :][:160]
