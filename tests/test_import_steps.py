@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 import yaml
 
 from simkit.importer import import_robot, writer
@@ -186,3 +187,77 @@ def test_fixed_joint_names_are_kept(tmp_path):
     robot = resolve(loaded, doc.text.encode(), done.spec_path.name)
     text = b"".join(urdf.emit(robot).values()).decode()
     assert '<joint name="fore-tool0_fixed_joint" type="fixed">' in text
+
+
+def _no_inertials(tmp_path: Path) -> Path:
+    """An arm whose URDF has no <inertial> at all: a box base, a box upper arm and a mesh
+    forearm (a closed 0.1 x 0.1 x 0.2 m box mesh)."""
+    import trimesh
+
+    (tmp_path / "fore.stl").write_bytes(
+        trimesh.creation.box((0.1, 0.1, 0.2)).export(file_type="stl")
+    )
+    fore = (
+        '<link name="fore"><visual><origin xyz="0 0 0.1"/><geometry>'
+        '<mesh filename="fore.stl"/></geometry></visual></link>'
+    )
+    body = box("base", "0.2 0.2 0.1", "0 0 0.05", None)
+    body += box("upper", "0.05 0.05 0.3", "0 0 0.15", None) + fore
+    body += joint("shoulder", "revolute", "base", "upper", "0 0 0.1")
+    body += joint("elbow", "revolute", "upper", "fore", "0 0 0.3")
+    return write(tmp_path, body, "bare")
+
+
+def test_urdf_without_inertials_gets_the_mass_of_its_solids(tmp_path):
+    path = _no_inertials(tmp_path)
+    done = import_robot(path, tmp_path / "out")
+    links = {link["name"]: link for link in yaml.safe_load(done.spec_path.read_text())["links"]}
+    assert abs(links["base"]["mass"] - 2700 * 0.2 * 0.2 * 0.1) < 1e-6  # 10.8 kg of aluminium
+    assert abs(links["upper"]["mass"] - 2700 * 0.05 * 0.05 * 0.3) < 1e-6
+    assert abs(links["fore"]["mass"] - 2700 * 0.1 * 0.1 * 0.2) < 1e-3  # the mesh's volume
+    assert abs(links["fore"]["com"][2] - 0.1) < 1e-6
+    fore = links["fore"]["inertia"]  # a solid box: m (a^2 + b^2) / 12
+    assert abs(fore["ixx"] - 5.4 * (0.1**2 + 0.2**2) / 12) < 1e-6
+    assert {"mass", "com", "inertia"} <= set(links["upper"]["estimated"])
+    lines = [ln for ln in done.lines if "visual solid's volume" in ln]
+    assert len(lines) == 3 and all("2700 kg/m^3" in ln for ln in lines)
+    light = import_robot(path, tmp_path / "light", density=1000.0)
+    links = {link["name"]: link for link in yaml.safe_load(light.spec_path.read_text())["links"]}
+    assert abs(links["upper"]["mass"] - 1000 * 0.05 * 0.05 * 0.3) < 1e-6
+
+
+def test_estimated_armature_never_swamps_what_the_joint_moves(tmp_path):
+    """A 10 g finger on a 10 N m joint: 0.001 x effort would be 0.01 kg m^2, thousands of
+    times its own inertia; the armature is held to that inertia and the servo softened so it
+    keeps its frequency. A heavy link keeps 0.001 x effort."""
+    from simkit.importer.masses import SERVO_OMEGA
+
+    body = box("base", "0.1 0.1 0.1", "0 0 0.05", 5.0)
+    body += box("upper", "0.05 0.05 0.4", "0 0 0.2", 8.0)
+    body += box("tip", "0.01 0.01 0.05", "0 0 0.025", 0.01).replace(
+        'ixx="0.001" iyy="0.001" izz="0.001"', 'ixx="1e-6" iyy="1e-6" izz="1e-6"'
+    )
+    body += joint("shoulder", "revolute", "base", "upper", "0 0 0.1", effort=100)
+    body += joint("finger", "revolute", "upper", "tip", "0 0 0.4", effort=10)
+    done = import_robot(write(tmp_path, body, "finger"), tmp_path / "out")
+    joints = {j["name"]: j for j in yaml.safe_load(done.spec_path.read_text())["joints"]}
+    assert joints["shoulder"]["armature"] == 0.1 and "kp" not in joints["shoulder"]
+    finger = joints["finger"]
+    own = 1e-6 + 0.01 * 0.025**2  # its inertia about its CoM plus m d^2: 7.25e-6 kg m^2
+    assert finger["armature"] <= own * 1.01 and finger["armature"] < 0.01 / 100
+    kp = SERVO_OMEGA**2 * (own + finger["armature"])
+    assert abs(finger["kp"] - kp) / kp < 0.01
+    assert {"armature", "kp"} <= set(finger["estimated"])
+    assert any("would swamp it" in ln and "servo kp" in ln for ln in done.lines)
+
+
+@pytest.mark.slow
+def test_bolted_and_standing_humanoids_pass_their_checks(tmp_path, kit_factory):
+    """The invariant on the small humanoid: with default flags it floats and stands, with
+    --fixed-base it is bolted at the pelvis; either kit passes every check (the build
+    raises on a failed one)."""
+    path = write(tmp_path, _biped(fold=True), "folded")
+    for floating in (None, False):
+        done = import_robot(path, tmp_path / f"out_{floating}", floating=floating)
+        result = kit_factory(str(done.spec_path))
+        assert all(f.ok for f in result.findings)
