@@ -9,9 +9,12 @@ shapes stance.py collides, floor contact only: home is free of self-contact alre
 the spec's real masses and inertias, each actuated joint held at home by a position servo
 as the kit's (kp = effort per 0.01 rad, force limited to the effort). Where the robot comes
 to rest tilted (more than `TILT`) with its frame (the base or a link welded to it) on the
-floor, and each servo holds its joint with at most `LIMIT` of its effort (the static torque
-the contact forces leave it), the settled pose becomes the free joint's origin, so the kit
-starts where the robot rests. Legged robots standing on their feet keep their level base.
+floor, the robot must not rest leaning: the search takes the pose (home, else a seeded
+candidate) on which it rests within `UPRIGHT` of level on its frame, each servo holding its
+joint with at most `LIMIT` of its effort (the static torque the contact forces leave it); the
+settled pose becomes the free joint's origin, so the kit starts where the robot rests. Where
+no pose rests so, the base stays level (standing.py). Legged robots standing on their feet
+keep their level base.
 """
 
 from __future__ import annotations
@@ -26,6 +29,8 @@ import numpy as np
 SECONDS = 2.0  # s of settling
 TIMESTEP = 0.002  # s, as the kit's MJCF
 TILT = 0.02  # rad: a settled base turned less than this stays level
+#: rad: the most a floating base may rest tilted (issue 22: it stands within 5 deg of upright)
+UPRIGHT = math.radians(5.0)
 LIMIT = 0.8  # share of its effort a servo may need to hold the rest (kit page: 80 % rule)
 CANDIDATES = 48  # seeded random poses tried where home does not rest within LIMIT
 EDGE = 0.05  # share of a joint's range at each end no candidate is drawn from
@@ -52,8 +57,9 @@ class Rest:
         return max(self.loads.items(), key=lambda kv: (kv[1], kv[0]), default=("", 0.0))
 
     def holds(self) -> bool:
-        """Resting, frame down, tilted, every servo within LIMIT: worth starting from."""
-        return self.still and self.frame_down and self.tilt > TILT and self.worst[1] <= LIMIT
+        """Resting, frame down, within UPRIGHT of level, every servo within LIMIT: worth
+        starting from."""
+        return self.still and self.frame_down and self.tilt <= UPRIGHT and self.worst[1] <= LIMIT
 
 
 def _text(values) -> str:
