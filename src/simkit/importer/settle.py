@@ -178,7 +178,7 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
             "position",
             name=joint.name,
             joint=joint.name,
-            kp=repr(SERVO_STIFFNESS * effort),
+            kp=repr(joint.kp or SERVO_STIFFNESS * effort),  # a softened servo: masses.py
             dampratio="1",
             forcerange=_text([-effort, effort]),
         )
