@@ -261,3 +261,16 @@ def test_bolted_and_standing_humanoids_pass_their_checks(tmp_path, kit_factory):
         done = import_robot(path, tmp_path / f"out_{floating}", floating=floating)
         result = kit_factory(str(done.spec_path))
         assert all(f.ok for f in result.findings)
+
+
+def test_home_off_the_zero_pose_is_reported(tmp_path):
+    """A joint whose range leaves out 0 starts mid-range: one line says so; a joint at the
+    URDF's zero pose gets none."""
+    body = _arm()  # shoulder first, then elbow: only the elbow's range leaves out 0
+    at = body.index('name="elbow"')
+    body = body[:at] + body[at:].replace('lower="-1.0" upper="1.0"', 'lower="0.5" upper="1.5"')
+    done = import_robot(write(tmp_path, body, "offset"), tmp_path / "out")
+    spec = yaml.safe_load(done.spec_path.read_text())
+    assert spec["poses"]["home"] == [0.0, 1.0]
+    lines = [ln for ln in done.lines if "the URDF's zero pose is outside it" in ln]
+    assert len(lines) == 1 and "joint[elbow]" in lines[0] and "home: 1," in lines[0]

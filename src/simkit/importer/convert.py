@@ -190,6 +190,7 @@ def convert(
     movable = [j for j in spec_joints if j["type"] not in ("fixed", "floating")]
     if movable:
         home = {j["name"]: _home(j) for j in movable}
+        _report_mid_range(source, movable, home, report)
         for j in movable:  # a mimic joint follows its leader
             if "mimic" in j and j["mimic"]["joint"] in home:
                 m = j["mimic"]
@@ -297,6 +298,20 @@ def _depth_first(joints: list[dict], root: str, first: set[str] = frozenset()) -
         out.append(joint)
         stack.extend(reversed(by_parent.get(joint["child"], [])))
     return out
+
+
+def _report_mid_range(source: Source, movable: list[dict], home: dict, report: Report) -> None:
+    """One line per joint whose home is not the URDF's zero pose because 0 is outside its
+    limits (a mimic follower follows its leader: none)."""
+    for j in movable:
+        if home[j["name"]] != 0.0 and "mimic" not in j:
+            element = source.root.find(f"joint[@name='{j['name']}']")
+            report.assumed(
+                source,
+                source.root if element is None else element,
+                f"home: {home[j['name']]:.4g}, the middle of its range {j['lower']:.4g} .. "
+                f"{j['upper']:.4g} (the URDF's zero pose is outside it)",
+            )
 
 
 def _home(joint: dict) -> float:
