@@ -286,7 +286,8 @@ def test_written_meshes_do_not_depend_on_the_repair_s_face_order():
     sphere = trimesh.creation.icosphere(2)
     rng = np.random.default_rng(0)
     shuffled = sphere.faces[rng.permutation(len(sphere.faces))]
-    turned = np.array([np.roll(f, k) for f, k in zip(shuffled, rng.integers(0, 3, len(shuffled)))])
+    turns = rng.integers(0, 3, len(shuffled))
+    turned = np.array([np.roll(f, k) for f, k in zip(shuffled, turns, strict=True)])
     assert not np.array_equal(turned, sphere.faces)
     _v, one = writer.canonical_faces(sphere.vertices, sphere.faces)
     _v, two = writer.canonical_faces(sphere.vertices, turned)
