@@ -54,10 +54,16 @@ def _has_movable(path: Path) -> bool:
 
 
 def _name(rel: Path) -> str:
-    """A spec name from the URDF's path: its folder and stem, [a-z][a-z0-9_]*, 48 at most."""
-    parts = [*rel.parent.parts[-1:], rel.name.split(".")[0]]
+    """A spec name from the URDF's whole relative path (two folders may hold the same file
+    name), [a-z][a-z0-9_]*, 48 characters at most (a digest ends a longer one)."""
+    import hashlib
+
+    parts = [*rel.parent.parts, rel.name.split(".")[0]]
     name = re.sub(r"[^a-z0-9_]+", "_", "_".join(parts).lower()).strip("_") or "robot"
-    return (name if name[0].isalpha() else f"r_{name}")[:48].rstrip("_")
+    name = name if name[0].isalpha() else f"r_{name}"
+    if len(name) > 48:
+        name = name[:41].rstrip("_") + "_" + hashlib.sha256(name.encode()).hexdigest()[:6]
+    return name
 
 
 def _run(args: list[str], timeout: float) -> tuple[int, str, str, float]:

@@ -166,7 +166,11 @@ def test_corpus_script_takes_any_folder_with_default_flags(tmp_path):
     found = corpus.urdfs(tmp_path, ["random_urdfs/*"], movable_only=True)
     assert [p.relative_to(tmp_path).as_posix() for p in found] == ["arm/arm.urdf"]
     assert len(corpus.urdfs(tmp_path, [], movable_only=False)) == 3
-    assert corpus._name(Path("talos_data/robots/talos-full.v2.urdf")) == "robots_talos_full"
+    assert corpus._name(Path("talos_data/robots/talos-full.v2.urdf")) == (
+        "talos_data_robots_talos_full"
+    )
+    long = corpus._name(Path("a_very_long_folder_name/another_long_folder/robot_name.urdf"))
+    assert len(long) <= 48 and long != corpus._name(Path("a_very_long_folder_name/x.urdf"))
     urdf = tmp_path / "arm" / "arm.urdf"
     assert corpus._refusal(urdf, "simkit: error: arm.urdf:3: joint[j]: bad\n") == ""
     assert corpus._refusal(urdf, "Traceback (most recent call last):\n  x\n") == "traceback"
