@@ -1,7 +1,7 @@
 """Import and build every URDF of a folder with `simkit import`'s default flags; one table.
 
     python scripts/import_corpus.py CORPUS_DIR [--exclude GLOB ...] [--movable-only]
-        [--title TITLE] [--timeout S] [--out DIR] [--md FILE] [--limit N]
+        [--only GLOB ...] [--title TITLE] [--timeout S] [--out DIR] [--md FILE] [--limit N]
 
 Each URDF (sorted by path, `--exclude` globs matched against the path relative to
 CORPUS_DIR): `simkit import URDF --out DIR` with no other flag, a cold build with an empty
@@ -30,13 +30,16 @@ REPO = Path(__file__).resolve().parents[1]
 MOVABLE = {"revolute", "continuous", "prismatic"}
 
 
-def urdfs(root: Path, exclude: list[str], movable_only: bool) -> list[Path]:
-    """The corpus's URDFs, sorted, less the excluded ones (and those without a movable
-    joint when asked; a file that does not parse is kept: the import must refuse it)."""
+def urdfs(root: Path, exclude: list[str], movable_only: bool, only: list[str] = ()) -> list[Path]:
+    """The corpus's URDFs, sorted, less the excluded ones, only those matching `only` if
+    given (and those without a movable joint when asked; a file that does not parse is kept:
+    the import must refuse it)."""
     out = []
     for path in sorted(root.rglob("*.urdf")):
         rel = path.relative_to(root).as_posix()
         if any(fnmatch.fnmatch(rel, glob) for glob in exclude):
+            continue
+        if only and not any(fnmatch.fnmatch(rel, glob) for glob in only):
             continue
         if movable_only and not _has_movable(path):
             continue
@@ -193,6 +196,7 @@ def main() -> None:
     parser.add_argument("corpus", type=Path, help="folder searched for *.urdf")
     parser.add_argument("--exclude", action="append", default=[], help="glob of paths to skip")
     parser.add_argument("--movable-only", action="store_true", help="only URDFs with a joint")
+    parser.add_argument("--only", action="append", default=[], help="glob of paths to run")
     parser.add_argument("--title", default=None, help="the table's heading [folder name]")
     parser.add_argument("--timeout", type=float, default=600.0, help="s per command")
     parser.add_argument("--limit", type=int, default=0, help="run the first N only")
@@ -202,7 +206,7 @@ def main() -> None:
     root = args.corpus.resolve()
     if not root.is_dir():
         sys.exit(f"{args.corpus}: not a folder")
-    found = urdfs(root, args.exclude, args.movable_only)
+    found = urdfs(root, args.exclude, args.movable_only, args.only)
     found = found[: args.limit] if args.limit else found
     title = args.title or root.name
     command = (
