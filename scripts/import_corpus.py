@@ -1,62 +1,77 @@
-"""Import and build every URDF of example-robot-data (issue 15); print and save the table.
+"""Import and build every URDF of a folder with `simkit import`'s default flags; one table.
 
-    python scripts/import_corpus.py [--only SUBSTR ...] [--timeout S] [--hull] [--out DIR]
-    python scripts/import_corpus.py --rerun --only SUBSTR ...   # after a fix: replace rows
+    python scripts/import_corpus.py CORPUS_DIR [--exclude GLOB ...] [--movable-only]
+        [--only GLOB ...] [--title TITLE] [--timeout S] [--out DIR] [--md FILE] [--limit N]
 
-Each robot: `simkit import` (with `--hull` if asked), a cold build with an empty cache,
-then a warm build with the same cache. Writes docs/import-corpus.md. Runs one build at a time.
+Each URDF (sorted by path, `--exclude` globs matched against the path relative to
+CORPUS_DIR): `simkit import URDF --out DIR` with no other flag, a cold build with an empty
+cache, then the same import again into the same folder. It checks issue 22's invariant: an
+import either refuses in one line naming the URDF's own file, or writes a spec that
+validates, builds and compiles in MuJoCo; never a traceback; the re-import gives
+byte-identical files and no stale ones. The table (one per `--title`, default the folder's
+name) goes into docs/import-corpus.md, replacing that corpus's earlier table, with the
+median import + cold build time. Runs one command at a time. No robot is named here.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
+import fnmatch
 import re
-import resource
 import shutil
-import site
+import statistics
 import subprocess
 import sys
 import time
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-#: robot folders whose root link moves freely (legged, humanoid, flying): --floating-base
-FLOATING = (
-    "a1_", "alexander_", "anymal", "b1_", "bolt_", "borinot", "centauro", "g1_",
-    "go1_", "go2_", "hector", "hextilt", "human_", "hyq", "icub", "iris", "laikago",
-    "quadruped", "romeo", "simple_humanoid", "solo_", "talos_data",
-)  # fmt: skip
-#: URDFs in those folders that are fixed-base all the same: a single arm (Talos's left arm);
-#: Alex (alex_description) is an upper body without legs, mounted on a stand, so not listed
-FIXED = ("talos_left_arm.urdf",)
+MOVABLE = {"revolute", "continuous", "prismatic"}
 
 
-def floating(rel: Path) -> bool:
-    """Whether the corpus URDF at `rel` (relative to the corpus root) has a floating base."""
-    return rel.parts[0].startswith(FLOATING) and rel.name not in FIXED
+def urdfs(root: Path, exclude: list[str], movable_only: bool, only: list[str] = ()) -> list[Path]:
+    """The corpus's URDFs, sorted, less the excluded ones, only those matching `only` if
+    given (and those without a movable joint when asked; a file that does not parse is kept:
+    the import must refuse it)."""
+    out = []
+    for path in sorted(root.rglob("*.urdf")):
+        rel = path.relative_to(root).as_posix()
+        if any(fnmatch.fnmatch(rel, glob) for glob in exclude):
+            continue
+        if only and not any(fnmatch.fnmatch(rel, glob) for glob in only):
+            continue
+        if movable_only and not _has_movable(path):
+            continue
+        out.append(path)
+    return out
 
 
-BIG = ("talos_full_v2.urdf", "g1_29dof_rev_1_0", "tiago.urdf", "pr2.urdf")
+def _has_movable(path: Path) -> bool:
+    try:
+        text = path.read_bytes().lstrip()
+        root = ET.fromstring(text[text.find(b"<robot") :] if b"<robot" in text else text)
+    except ET.ParseError:
+        return b'type="revolute"' in text or b'type="continuous"' in text
+    return any(j.get("type") in MOVABLE for j in root.iter("joint"))
 
 
-def corpus() -> Path:
-    for base in site.getsitepackages():
-        path = Path(base) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-        if path.is_dir():
-            return path
-    sys.exit("example-robot-data is not installed (pip install example-robot-data==6.0.0)")
+def _name(rel: Path) -> str:
+    """A spec name from the URDF's whole relative path (two folders may hold the same file
+    name), [a-z][a-z0-9_]*, 48 characters at most (a digest ends a longer one)."""
+    import hashlib
+
+    parts = [*rel.parent.parts, rel.name.split(".")[0]]
+    name = re.sub(r"[^a-z0-9_]+", "_", "_".join(parts).lower()).strip("_") or "robot"
+    name = name if name[0].isalpha() else f"r_{name}"
+    if len(name) > 48:
+        name = name[:41].rstrip("_") + "_" + hashlib.sha256(name.encode()).hexdigest()[:6]
+    return name
 
 
-def _cpu() -> float:
-    """CPU seconds (user + system) used by finished child processes so far."""
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
-
-
-def _run(args: list[str], timeout: float) -> tuple[int, str, tuple[float, float]]:
-    """Exit code, last line of output, and (wall s, CPU s) of one simkit command."""
-    start, cpu = time.perf_counter(), _cpu()
+def _run(args: list[str], timeout: float) -> tuple[int, str, str, float]:
+    """Exit code, stdout, stderr and wall seconds of one simkit command."""
+    start = time.perf_counter()
     try:
         done = subprocess.run(
             [sys.executable, "-m", "simkit.cli", *args],
@@ -65,129 +80,148 @@ def _run(args: list[str], timeout: float) -> tuple[int, str, tuple[float, float]
             timeout=timeout,
         )
     except subprocess.TimeoutExpired:
-        return 124, f"timed out after {timeout:.0f} s", (time.perf_counter() - start, 0.0)
-    text = (done.stderr.strip().splitlines() or [""])[-1] if done.returncode else done.stdout
-    return done.returncode, text, (time.perf_counter() - start, _cpu() - cpu)
+        return 124, "", f"timed out after {timeout:.0f} s", time.perf_counter() - start
+    return done.returncode, done.stdout, done.stderr, time.perf_counter() - start
 
 
-def _first_failure(message: str) -> str:
-    found = re.search(r"FAIL ([\w.]+)", message)
-    return found.group(1) if found else message[:90]
+def _files(folder: Path) -> dict[str, bytes]:
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
 
 
-def one(urdf: Path, root: Path, work: Path, timeout: float, hull: bool) -> dict:
+def _refusal(urdf: Path, stderr: str) -> str:
+    """'' when an import's refusal keeps the invariant (one line naming the URDF's file),
+    else what is wrong with it."""
+    lines = [ln for ln in stderr.strip().splitlines() if ln.strip()]
+    if "Traceback" in stderr:
+        return "traceback"
+    if len(lines) != 1:
+        return f"{len(lines)} lines of error"
+    if urdf.name not in lines[0]:
+        return "the error does not name the URDF"
+    return ""
+
+
+def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
+    """Import, build and re-import one URDF; its table row."""
     rel = urdf.relative_to(root)
-    name = re.sub(r"[^a-z0-9_]+", "_", f"{rel.parts[0]}_{urdf.stem}".lower())
-    name = name.replace("_description", "")
-    row = {"robot": str(rel), "import": "", "build": "", "failing": "", "cold": None,
-           "warm": None, "links": None, "coacd": None}  # fmt: skip
-    args = ["import", str(urdf), "--name", name, "--out", str(work / "specs" / name), "-q"]
-    args += ["--floating-base"] if floating(rel) else []
-    args += ["--hull"] if hull else []
-    rc, text, _s = _run(args, timeout)
+    name = _name(rel)
+    row = {"robot": rel.as_posix(), "import": "", "build": "", "reason": "", "invariant": "ok",
+           "seconds": None, "base": ""}  # fmt: skip
+    out = work / "specs" / name
+    shutil.rmtree(out, ignore_errors=True)
+    rc, stdout, stderr, import_s = _run(["import", str(urdf), "--name", name, "--out", str(out)],
+                                        timeout)  # fmt: skip
     if rc:
-        message = text.removeprefix("simkit: error: ").replace(str(root) + "/", "")
-        row["import"] = "error: " + message[:160]
+        row["import"] = "refused"
+        row["reason"] = stderr.strip().splitlines()[-1][:160] if stderr.strip() else f"rc {rc}"
+        row["reason"] = row["reason"].removeprefix("simkit: error: ").replace(str(root) + "/", "")
+        bad = _refusal(urdf, stderr) if rc != 124 else "timed out"
+        row["invariant"] = bad or "ok"
         return row
     row["import"] = "ok"
-    spec = work / "specs" / name / f"{name}.yaml"
+    row["base"] = "floating" if "floating base:" in stdout else "fixed"
+    first = _files(out)
     cache = work / "cache" / name
-    kits = work / "kits"
-    build = ["build", str(spec), "--out", str(kits), "-q", "--cache-dir", str(cache)]
-    shutil.rmtree(cache, ignore_errors=True)  # cold means cold: no entries from earlier runs
-    rc, text, row["cold"] = _run(build, timeout)
-    if rc:
-        row["build"] = "fail"
-        row["failing"] = _first_failure(text)
-        return row
-    rc, text, row["warm"] = _run(build, timeout)
-    row["build"] = "ok" if rc == 0 else "fail (warm)"
-    doc = json.loads((kits / f"{name}_description" / "robot.json").read_text())
-    row["links"] = len(doc["links"])
-    methods = [g.get("collision", {}).get("method") for g in doc["geometry"]["links"]]
-    row["coacd"] = sum(m == "coacd" for m in methods) / max(len(methods), 1)
+    shutil.rmtree(cache, ignore_errors=True)  # cold means cold
+    build = ["build", str(out / f"{name}.yaml"), "--out", str(work / "kits"), "-q"]
+    rc, _o, stderr, build_s = _run([*build, "--cache-dir", str(cache)], timeout)
+    row["seconds"] = import_s + build_s
+    failed = re.search(r"FAIL ([\w.]+)", stderr)
+    if rc == 0:
+        row["build"] = "ok"
+    elif rc == 124:  # the machine's load, not the invariant: no verdict
+        row["build"] = "timed out"
+        row["reason"] = stderr
+    elif failed:  # built and compiled; a check failed
+        row["build"] = "check failed"
+        row["reason"] = " ".join(stderr.split())[stderr.find("FAIL") :][:160]
+    else:  # the written spec was refused, or the build broke: the invariant is broken
+        row["build"] = "error"
+        row["reason"] = (stderr.strip().splitlines() or ["?"])[-1][:160]
+        row["invariant"] = "traceback" if "Traceback" in stderr else "spec refused by build"
+    rc, _o, _e, _s = _run(["import", str(urdf), "--name", name, "--out", str(out)], timeout)
+    if rc or _files(out) != first:
+        row["invariant"] = "re-import differs"
     return row
 
 
-def table(rows: list[dict]) -> str:
-    head = (
-        "| robot | import | build | first failing check | cold s (CPU s) | warm s (CPU s) "
-        "| links | CoACD |"
-    )
-    lines = [head, "|---|---|---|---|---:|---:|---:|---:|"]
+def table(rows: list[dict], total: int) -> str:
+    head = "| URDF | base | import | build | invariant | import + cold build s | reason |"
+    lines = [head, "|---|---|---|---|---|---:|---|"]
     for r in rows:
-        num = [f"{r[k][0]:.1f} ({r[k][1]:.1f})" if r[k] else "" for k in ("cold", "warm")]
-        share = f"{100 * r['coacd']:.0f} %" if r["coacd"] is not None else ""
+        seconds = f"{r['seconds']:.1f}" if r["seconds"] is not None else ""
+        reason = r["reason"].replace("|", "\\|")
         lines.append(
-            f"| {r['robot']} | {r['import']} | {r['build']} | {r['failing']} | {num[0]} | "
-            f"{num[1]} | {r['links'] or ''} | {share} |"
+            f"| {r['robot']} | {r['base']} | {r['import']} | {r['build']} | {r['invariant']} "
+            f"| {seconds} | {reason} |"
         )
     passed = sum(r["build"] == "ok" for r in rows)
-    lines.append("")
-    lines.append(
-        f"{passed} of {len(rows)} pass `simkit check` ({100 * passed / max(len(rows), 1):.1f} %)."
-    )
+    kept = sum(r["invariant"] == "ok" for r in rows)
+    times = [r["seconds"] for r in rows if r["seconds"] is not None]
+    median = f"{statistics.median(times):.1f} s" if times else "n/a"
+    partial = "" if len(rows) == total else f" (partial: {len(rows)} of {total} run)"
+    lines += [
+        "",
+        f"{passed} of {len(rows)} give a checked kit ({100 * passed / max(len(rows), 1):.1f} "
+        f"%){partial}; the invariant holds for {kept} of {len(rows)}; median import + cold "
+        f"build {median} per robot that imported.",
+    ]
     return "\n".join(lines) + "\n"
+
+
+def save(md: Path, title: str, command: str, body: str) -> None:
+    """Replace (or append) the `## title` section of `md`."""
+    text = md.read_text(encoding="utf-8") if md.is_file() else ""
+    if not text.startswith("# Import corpora"):
+        text = (
+            "# Import corpora\n\nMade by `scripts/import_corpus.py`: every URDF imported "
+            "with `simkit import`'s default flags, built with an empty cache (wall seconds "
+            "on 2 shared cores), then imported again into the same folder.\n"
+        )
+    section = f"## {title}\n\n`{command}`\n\n{body}"
+    pattern = re.compile(rf"^## {re.escape(title)}\n.*?(?=^## |\Z)", re.S | re.M)
+    if pattern.search(text):
+        text = pattern.sub(lambda _m: section + "\n", text)
+    else:
+        text = text.rstrip("\n") + "\n\n" + section
+    md.write_text(text.rstrip("\n") + "\n", encoding="utf-8")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", nargs="*", default=[], help="substrings of robot paths")
-    parser.add_argument("--timeout", type=float, default=600.0, help="s per import or build")
-    parser.add_argument("--hull", action="store_true", help="import with --hull")
+    parser.add_argument("corpus", type=Path, help="folder searched for *.urdf")
+    parser.add_argument("--exclude", action="append", default=[], help="glob of paths to skip")
+    parser.add_argument("--movable-only", action="store_true", help="only URDFs with a joint")
+    parser.add_argument("--only", action="append", default=[], help="glob of paths to run")
+    parser.add_argument("--title", default=None, help="the table's heading [folder name]")
+    parser.add_argument("--timeout", type=float, default=600.0, help="s per command")
+    parser.add_argument("--limit", type=int, default=0, help="run the first N only")
     parser.add_argument("--out", type=Path, default=Path("/tmp/simkit-corpus"))
     parser.add_argument("--md", type=Path, default=REPO / "docs" / "import-corpus.md")
-    parser.add_argument(
-        "--rerun",
-        action="store_true",
-        help="with --only: rerun these robots and replace their rows in OUT/rows.json (the "
-        "last full run), then rewrite the table",
-    )
     args = parser.parse_args()
-    root = corpus()
-    # the largest robots first (issue 15's performance targets), then the rest by path
-    urdfs = sorted(root.rglob("*.urdf"), key=lambda p: (not p.name.startswith(BIG), str(p)))
-    if args.only:
-        urdfs = [p for p in urdfs if any(s in str(p.relative_to(root)) for s in args.only)]
-    saved = args.out / "rows.json"
-    earlier = json.loads(saved.read_text()) if args.rerun and saved.is_file() else []
-    rows = []
-    for urdf in urdfs:
-        row = one(urdf, root, args.out, args.timeout, args.hull)
-        rows.append(row)
-        print(f"{row['robot']}: import {row['import']}, build {row['build']} {row['failing']} "
-              f"cold {row['cold']} warm {row['warm']}", flush=True)  # fmt: skip
-        if not args.rerun:
-            _save(args.md, rows, len(urdfs))
-            saved.write_text(json.dumps(rows, indent=1))
-    if args.rerun:  # the rows of the last full run, these robots replaced
-        fresh = {r["robot"]: r for r in rows}
-        rows = [fresh.get(r["robot"], r) for r in earlier]
-        saved.write_text(json.dumps(rows, indent=1))
-        _save(args.md, rows, len(rows), rerun=sorted(fresh))
-    print(table(rows))
-
-
-def _save(md: Path, rows: list[dict], total: int, rerun: list[str] = ()) -> None:
-    """Write the table so far (a long run leaves a partial table if stopped)."""
-    done = "" if len(rows) == total else f" (partial: {len(rows)} of {total} URDFs run)"
-    if rerun:
-        done = (
-            " (rows of the last full run, saved in OUT/rows.json, with these robots rerun "
-            f"after fixes: {', '.join(rerun)})"
-        )
-    md.write_text(
-        "# Import corpus: example-robot-data 6.0.0\n\n"
-        "Made by `python scripts/import_corpus.py "
-        + " ".join(sys.argv[1:])
-        + "`"
-        + done
-        + ": import as `simkit import` does by default (URDF collision kept as convex pieces, "
-        "CoACD "
-        "above ten), `--hull` if given; cold = empty cache, warm = second build "
-        "with that cache; wall seconds with CPU seconds (user + system, all processes) in "
-        "brackets, on 2 cores shared with other work.\n\n" + table(rows)
+    root = args.corpus.resolve()
+    if not root.is_dir():
+        sys.exit(f"{args.corpus}: not a folder")
+    found = urdfs(root, args.exclude, args.movable_only, args.only)
+    found = found[: args.limit] if args.limit else found
+    title = args.title or root.name
+    command = (
+        "python scripts/import_corpus.py CORPUS "
+        + " ".join(f"--exclude '{g}'" for g in args.exclude)
+        + (" --movable-only" if args.movable_only else "")
     )
+    rows = []
+    for urdf in found:
+        rows.append(one(urdf, root, args.out, args.timeout))
+        r = rows[-1]
+        print(f"{r['robot']}: {r['import']} {r['build']} {r['invariant']} {r['reason']}",
+              flush=True)  # fmt: skip
+        save(args.md, title, command.strip(), table(rows, len(found)))
+    print(table(rows, len(found)))
 
 
 if __name__ == "__main__":

@@ -96,13 +96,13 @@ def test_home_clears_visual_pieces_the_collision_leaves_apart(tmp_path):
 def test_search_lets_a_pair_overlapping_at_the_start_go_a_little_deeper():
     # Baxter's elbow: the hulls of two visual pieces overlap by 48 mm at the start and by
     # 0.1 mm more as the elbow folds; the kit's pieces, which follow the mesh, stay apart
-    search = object.__new__(gravity._Search)
+    search = object.__new__(gravity.Search)
     search.near = {(0, 1): -0.048, (2, 3): 0.01}
-    assert search._allowed((0, 1), -0.048 - 0.0001)
-    assert not search._allowed((0, 1), -0.048 - 2 * gravity.SLACK)
-    assert search._allowed((2, 3), 0.003)  # apart at the start: the clearance, no slack
-    assert not search._allowed((2, 3), 0.003 - gravity.SLACK / 2)
-    assert not search._allowed((4, 5), 0.0)  # a new pair inside the clearance
+    assert search.allowed((0, 1), -0.048 - 0.0001)
+    assert not search.allowed((0, 1), -0.048 - 2 * gravity.SLACK)
+    assert search.allowed((2, 3), 0.003)  # apart at the start: the clearance, no slack
+    assert not search.allowed((2, 3), 0.003 - gravity.SLACK / 2)
+    assert not search.allowed((4, 5), 0.0)  # a new pair inside the clearance
 
 
 def _gripper(multiplier: float, lower: float, upper: float) -> str:

@@ -71,7 +71,7 @@ def test_always_rule_counts_touching_faces_and_almost_always(tmp_path):
         always_pairs,
         configurations,
     )
-    from simkit.importer import home
+    from simkit.importer import collide
 
     robot, _done = _robot(tmp_path, ALWAYS)
     q = configurations(robot, robot.seed, 1000)
@@ -80,9 +80,9 @@ def test_always_rule_counts_touching_faces_and_almost_always(tmp_path):
     assert ("arm", "post") in always  # apart in a few per cent of q only
     assert not any("free" in p for p in always)
     # the importer's home search and the derive stage share the rule
-    assert (home.ALWAYS_FRACTION, home.TOUCH) == (ALWAYS_FRACTION, TOUCH)
+    assert (collide.ALWAYS_FRACTION, collide.TOUCH) == (ALWAYS_FRACTION, TOUCH)
     start = np.zeros(len(robot.movable_joints))
-    found = home._always_touching(robot, tmp_path / "out", start, lambda v: v)
+    found = collide.always_touching(robot, tmp_path / "out", start, lambda v: v)
     assert {("block", "wall"), ("arm", "post")} <= set(found)
 
 

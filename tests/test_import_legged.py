@@ -88,7 +88,7 @@ def test_always_touching_pairs_are_found(tmp_path):
         + _joint("shoulder", "body", "arm", "0 0.2 0", "1 0 0", "3")
         + "</robot>"
     )
-    done = import_robot(_write(tmp_path, urdf), tmp_path / "out")
+    done = import_robot(_write(tmp_path, urdf), tmp_path / "out", floating=False)  # bolted
     text = done.spec_path.read_text()
     spec, _doc = load_spec(done.spec_path)
     robot = resolve(spec, text.encode(), done.spec_path.name)
@@ -105,7 +105,7 @@ def test_floating_urdf_without_collision_collides_with_its_visuals(tmp_path):
     links = yaml.safe_load(done.spec_path.read_text())["links"]
     assert all(link["collision"] == "mesh" and "collision" in link["estimated"] for link in links)
     assert any("no <collision> in the URDF" in line for line in done.lines)
-    fixed = import_robot(path, tmp_path / "fixed")
+    fixed = import_robot(path, tmp_path / "fixed", floating=False)
     links = yaml.safe_load(fixed.spec_path.read_text())["links"]
     assert all(link["collision"] == "primitives" for link in links)  # as the URDF says
 
@@ -150,14 +150,32 @@ def test_open_mesh_hull_is_a_solid_at_stl_precision():
     assert _is_solid(back.vertices, back.faces)
 
 
-def test_corpus_script_imports_arms_fixed():
+def test_corpus_script_takes_any_folder_with_default_flags(tmp_path):
+    """scripts/import_corpus.py: any folder, --exclude globs, --movable-only; no robot
+    lists; a refusal keeps the invariant only as one line naming the URDF."""
     spec = importlib.util.spec_from_file_location("corpus", REPO / "scripts" / "import_corpus.py")
     corpus = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(corpus)
-    assert corpus.floating(Path("talos_data/robots/talos_reduced.urdf"))
-    assert not corpus.floating(Path("talos_data/robots/talos_left_arm.urdf"))
-    assert not corpus.floating(Path("alex_description/urdf/alex_nub_hands.urdf"))
-    assert corpus.floating(Path("g1_description/urdf/g1_29dof_rev_1_0.urdf"))
+    moving = '<robot name="a"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+    moving += '<parent link="a"/><child link="b"/></joint></robot>'
+    (tmp_path / "arm").mkdir()
+    (tmp_path / "arm" / "arm.urdf").write_text(moving)
+    (tmp_path / "random_urdfs").mkdir()
+    (tmp_path / "random_urdfs" / "x.urdf").write_text(moving)
+    (tmp_path / "block.urdf").write_text('<robot name="b"><link name="b"/></robot>')
+    found = corpus.urdfs(tmp_path, ["random_urdfs/*"], movable_only=True)
+    assert [p.relative_to(tmp_path).as_posix() for p in found] == ["arm/arm.urdf"]
+    assert len(corpus.urdfs(tmp_path, [], movable_only=False)) == 3
+    assert corpus._name(Path("talos_data/robots/talos-full.v2.urdf")) == (
+        "talos_data_robots_talos_full"
+    )
+    long = corpus._name(Path("a_very_long_folder_name/another_long_folder/robot_name.urdf"))
+    assert len(long) <= 48 and long != corpus._name(Path("a_very_long_folder_name/x.urdf"))
+    urdf = tmp_path / "arm" / "arm.urdf"
+    assert corpus._refusal(urdf, "simkit: error: arm.urdf:3: joint[j]: bad\n") == ""
+    assert corpus._refusal(urdf, "Traceback (most recent call last):\n  x\n") == "traceback"
+    assert corpus._refusal(urdf, "simkit: error: /tmp/x.yaml: bad\n") != ""
+    assert not hasattr(corpus, "FLOATING")
 
 
 def _walker() -> str:
@@ -207,7 +225,7 @@ def test_imported_rigid_quadrotor_rests(tmp_path, kit_factory):
 def test_flying_arm_rests_on_its_frame(tmp_path):
     """A frame with a thin two-link arm hanging below: balanced on the arm's tip it cannot
     rest, so home folds the arm up and the frame carries the weight (the arm's servos do not)."""
-    from simkit.importer.stance import MARGIN, _Support
+    from simkit.importer.stance import MARGIN, Support
     from simkit.model.resolve import resolve
 
     urdf = (
@@ -222,7 +240,7 @@ def test_flying_arm_rests_on_its_frame(tmp_path):
     done = import_robot(_write(tmp_path, urdf), tmp_path / "out", floating=True)
     spec, doc = load_spec(done.spec_path)
     robot = resolve(spec, doc.text.encode(), done.spec_path.name)
-    support = _Support(robot, done.spec_path.parent)
+    support = Support(robot, done.spec_path.parent)
     assert support.margin([0.0, 0.0]) < MARGIN  # the first guess stands on the arm's tip
     home = spec.poses["home"]
     assert home != (0.0, 0.0) and support.margin(home, frame_only=True) >= MARGIN

@@ -173,7 +173,7 @@ def test_lowest_point_of_a_tilted_round_shape_is_exact(kind):
     """A shape tilted 0.7 rad: its lowest point, not its bounding box's corner."""
     from types import SimpleNamespace
 
-    from simkit.importer.standing import _lowest, _points
+    from simkit.importer.standing import lowest, points
     from simkit.model.kinematics import rpy_matrix, transform
 
     shape = SimpleNamespace(kind=kind, radius=0.02, length=0.3, xyz=(0.1, 0.0, 0.0),
@@ -190,7 +190,7 @@ def test_lowest_point_of_a_tilted_round_shape_is_exact(kind):
         half = np.array([0.0, 0.0, shape.length / 2])
         rims = np.vstack([ring + half, ring - half]) @ rotation.T + centre
         expected = float(rims[:, 2].min()) - (shape.radius if kind == "capsule" else 0.0)
-    got = _lowest(shape, pose, Path("."))
+    got = lowest(shape, pose, Path("."))
     assert got == pytest.approx(expected, abs=1e-6)
-    corners = _points(shape, Path(".")) @ pose[:3, :3].T + pose[:3, 3]
+    corners = points(shape, Path(".")) @ pose[:3, :3].T + pose[:3, 3]
     assert float(corners[:, 2].min()) < got - 1e-3  # the corners reach below it

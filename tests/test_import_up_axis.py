@@ -77,8 +77,8 @@ def test_meshes_turn_only_where_the_joints_and_inertials_say(tmp_path, tip, turn
 def test_stance_scores_compare_in_order():
     """The stance search's last pass ranks poses by separable contact first, then by all
     contact (pairs its 200 samples call always touching that the kit's 10000 may not)."""
-    from simkit.importer.stance import _better
+    from simkit.importer.stance import better
 
-    assert _better((-0.0, -0.001), (-0.0, -0.003))
-    assert not _better((-0.002, 0.0), (-0.0, -0.003))
-    assert _better(-0.001, -0.002) and not _better(-0.002, -0.002)
+    assert better((-0.0, -0.001), (-0.0, -0.003))
+    assert not better((-0.002, 0.0), (-0.0, -0.003))
+    assert better(-0.001, -0.002) and not better(-0.002, -0.002)

@@ -454,6 +454,17 @@ def publish(
 @click.option("--strict", is_flag=True, help="Refuse instead of estimating missing values.")
 @click.option("--floating-base", is_flag=True, help="The root link moves freely (legged).")
 @click.option(
+    "--fixed-base",
+    is_flag=True,
+    help="The root link is bolted to the world. [default: decided from the robot's limbs]",
+)
+@click.option(
+    "--density",
+    type=click.FloatRange(min=1.0, max=25000.0),
+    default=None,
+    help="kg/m^3 of a massless link's visual solid, for its estimated mass. [default: 2700]",
+)
+@click.option(
     "--hull",
     "hull_collision",
     is_flag=True,
@@ -481,6 +492,8 @@ def import_urdf(
     package_dirs: tuple[Path, ...],
     strict: bool,
     floating_base: bool,
+    fixed_base: bool,
+    density: float | None,
     hull_collision: bool,
     out_dir: Path,
     quiet: bool,
@@ -493,12 +506,23 @@ def import_urdf(
     from simkit.importer import import_robot
     from simkit.importer.reading import ReadOptions, parse_xacro_arg
 
+    if floating_base and fixed_base:
+        _fail(SimkitError("--floating-base and --fixed-base exclude each other"))
+    floating = True if floating_base else False if fixed_base else None
     try:
         reading = ReadOptions(
             tuple(parse_xacro_arg(a) for a in xacro_args), allow_env, allow_read, trust_xacro
         )
         done = import_robot(
-            path, out_dir, name, package_dirs, strict, floating_base, hull_collision, reading
+            path,
+            out_dir,
+            name=name,
+            package_dirs=package_dirs,
+            strict=strict,
+            floating=floating,
+            hull_collision=hull_collision,
+            density=density,
+            reading=reading,
         )
     except SimkitError as exc:
         _fail(exc)

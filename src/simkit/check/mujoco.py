@@ -114,10 +114,10 @@ def check_models(kit: Kit) -> list[Finding]:
         tau_ur.append(dur.qfrc_bias[vb].copy())
         if tool:
             base = kit.base_frame
-            T_w_base_mj = _body_pose(mj, dmj, base)
-            T_w_base_ur = _body_pose(ur, dur, base)
-            T_mj = np.linalg.inv(T_w_base_mj) @ _site_or_body_pose(mj, dmj, tool)
-            T_ur = np.linalg.inv(T_w_base_ur) @ _body_pose(ur, dur, tool)
+            T_w_base_mj = body_pose(mj, dmj, base)
+            T_w_base_ur = body_pose(ur, dur, base)
+            T_mj = np.linalg.inv(T_w_base_mj) @ site_or_body_pose(mj, dmj, tool)
+            T_ur = np.linalg.inv(T_w_base_ur) @ body_pose(ur, dur, tool)
             T_json = kit.fk(q)
             pos_mj.append(T_mj[:3, 3])
             pos_ur.append(T_ur[:3, 3])
@@ -224,7 +224,7 @@ def _inertials(kit: Kit, links: list[str], mj: mujoco.MjModel, ur: mujoco.MjMode
     return out
 
 
-def _body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
+def body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
     out = np.eye(4)
     if name in ("world",) or mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) < 0:
         return out
@@ -234,14 +234,14 @@ def _body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndar
     return out
 
 
-def _site_or_body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
+def site_or_body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> np.ndarray:
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:
         site = data.site(name)
         out = np.eye(4)
         out[:3, :3] = site.xmat.reshape(3, 3)
         out[:3, 3] = site.xpos
         return out
-    return _body_pose(model, data, name)
+    return body_pose(model, data, name)
 
 
 def check_hold(kit: Kit) -> list[Finding]:

@@ -12,7 +12,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
-from simkit.check.mujoco import _body_pose, _site_or_body_pose, load_control_mjcf
+from simkit.check.mujoco import body_pose, load_control_mjcf, site_or_body_pose
 from simkit.check.readers.usd import (
     UsdJoint,
     UsdKinematics,
@@ -259,8 +259,8 @@ def _fk_findings(kit: Kit, mj, kin: UsdKinematics, paths: dict[str, str]) -> lis
     for q in configs:
         data.qpos[qadr] = q
         mujoco.mj_kinematics(mj, data)
-        inv = np.linalg.inv(_body_pose(mj, data, base))
-        exp.append([inv @ _site_or_body_pose(mj, data, t) for t in targets])
+        inv = np.linalg.inv(body_pose(mj, data, base))
+        exp.append([inv @ site_or_body_pose(mj, data, t) for t in targets])
         poses = kin.poses({prim_name(j["name"]): v for j, v in zip(joints, q, strict=True)})
         inv = np.linalg.inv(kin.pose(poses, paths[base]))
         act.append([inv @ kin.pose(poses, paths[t]) for t in targets])

@@ -132,7 +132,7 @@ def emit(robot: Robot) -> dict[str, bytes]:
             _joint(root, joint)
         _link(robot, root, links[joint.child], file)
     for frame in robot.frames:
-        joint = sub(root, "joint", name=f"{frame.name}_joint", type="fixed")
+        joint = sub(root, "joint", name=frame.joint_name, type="fixed")
         sub(joint, "parent", link=frame.parent)
         sub(joint, "child", link=frame.name)
         _origin(joint, frame.xyz, frame.rpy)

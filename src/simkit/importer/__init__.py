@@ -4,6 +4,12 @@ The spec keeps the URDF's numbers exactly; gaps are filled with plausible values
 `estimated` and reported one line each (`--strict` refuses them), and every element simkit
 does not keep is reported too. Output: DIR/NAME.yaml and DIR/meshes/*.stl (relative paths),
 written only when the whole import succeeded.
+
+The import is one in-memory draft (draft.py) passed through explicit, ordered steps:
+`translate` (the URDF to a spec dict: convert.py, names.py, blocks.py), then the pose
+fix-ups (fixups.STEPS: rotors, base, home, stand, limits), then `writer.finish`, which keeps
+the source (provenance.py), writes and validates the spec once, and moves the files into
+place whole (output.py). The staging folder is removed on every way out.
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from simkit.errors import SpecError
+from simkit.importer.draft import Draft
 from simkit.importer.reading import ReadOptions
 from simkit.importer.report import Report
 
@@ -27,85 +34,6 @@ class Imported:
     links: int
 
 
-def _stand(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str:
-    """Move home out of self-contact and onto a stance it rests on (`_free_stance`), raise
-    the floating base so the robot stands on the floor at home; rewrite the spec."""
-    from simkit.importer import standing, upright, writer
-
-    joint = spec["joints"][0]
-    turned = upright.upright(spec_path)
-    if turned is not None:  # a Y-up robot lies on its side at the identity
-        joint["rpy"], joint["estimated"] = [float(f"{v:.6g}") for v in turned[0]], ["rpy"]
-        report.assumed(doc, doc.root, turned[1])
-        spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
-    _free_stance(spec, report, doc, spec_path, path)
-    height = standing.standing_height(spec_path)
-    if height is None:
-        return spec_path.read_text(encoding="utf-8")
-    joint["xyz"] = [0.0, 0.0, float(f"{height:.6f}")]
-    joint["estimated"] = sorted({*joint.get("estimated", []), "xyz"})
-    report.changed(
-        doc,
-        doc.root,
-        f"floating base placed {height:.6f} m up: its lowest point at home on the floor",
-    )
-    text = writer.spec_yaml(spec, report.lines, path)
-    spec_path.write_text(text, encoding="utf-8")
-    return _settle(spec, report, doc, spec_path, path) or text
-
-
-def _settle(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> str | None:
-    """Start the free joint where the robot comes to rest at home when that is tilted onto
-    its frame (importer/settle.py: a flying arm leaning on its arm); the new spec text."""
-    from simkit.importer import settle, writer
-
-    found = settle.rest_pose(spec_path)
-    if found is None:
-        return None
-    pose, rest, why = found
-    if pose != spec["poses"]["home"]:
-        moved = ", ".join(
-            f"{j['name']}: {a:.4g} -> {b:.4g}"
-            for j, a, b in zip(_movable(spec), spec["poses"]["home"], pose, strict=True)
-            if a != b
-        )
-        why = f"home: the rest with the least servo load; {moved} rad or m; " + why
-        spec["poses"]["home"] = pose
-    joint = spec["joints"][0]
-    joint["xyz"] = [round(v, 4) + 0.0 for v in rest.xyz]
-    joint["rpy"] = [round(v, 4) + 0.0 for v in rest.rpy]
-    joint["estimated"] = sorted({*joint.get("estimated", []), "xyz", "rpy"})
-    report.assumed(doc, doc.root, why)
-    text = writer.spec_yaml(spec, report.lines, path)
-    spec_path.write_text(text, encoding="utf-8")
-    return text
-
-
-def _movable(spec: dict) -> list[dict]:
-    """The spec's one-degree-of-freedom joints, in spec (pose) order."""
-    return [j for j in spec["joints"] if j["type"] not in ("fixed", "floating")]
-
-
-def _step_budget(spec: dict, stage: Path, report: Report, doc) -> None:
-    """`step: false` (reported) when the visual meshes are too large for a faceted STEP."""
-    from simkit.importer.step_budget import step_fits
-
-    fits, why = step_fits(spec, stage)
-    if not fits:
-        spec["step"] = False
-        report.changed(doc, doc.root, why)
-
-
-def _up_axis(doc, mesh_writer, report: Report) -> None:
-    """Turn the URDF's Y_UP COLLADA meshes Z-up where its joints and inertials say they were
-    drawn so (up_axis.py); one report line either way when it has such meshes."""
-    from simkit.importer.up_axis import turn_y_up
-
-    mesh_writer.turn_y_up, why = turn_y_up(doc)
-    if why:
-        report.changed(doc, doc.root, why)
-
-
 def robot_name(path: Path) -> str:
     """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
     stem = path.name.split(".")[0].lower()
@@ -113,28 +41,34 @@ def robot_name(path: Path) -> str:
     return name if name[0].isalpha() else f"robot_{name}"
 
 
-def _free_home(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
-    """Move a fixed-base robot's `home` out of self-contact (home.py), then to where its
-    servos can hold it against gravity (gravity.py); rewrite the spec."""
-    from simkit.importer import gravity, home
+def translate(draft: Draft, name: str, floating: bool, hull_collision: bool, density: float) -> int:
+    """The URDF to the draft's spec: links, joints, frames and kept blocks, names made legal,
+    `--strict` problems refused, the STEP left out when the meshes are too large. Returns
+    the number of meshes written to the staging folder."""
+    from simkit.importer import blocks, convert, meshes, names
+    from simkit.importer.step_budget import step_fits
+    from simkit.importer.up_axis import turn_y_up
 
-    why = "the links collide at the first guess (0, or mid-range outside the limits)"
-    _new_home(home.free_home(spec_path), why, spec, report, doc, spec_path, path)
-    held = gravity.held_home(spec_path)
-    if held is not None:
-        _new_home(held[:2], held[2], spec, report, doc, spec_path, path)
-
-
-def _new_home(found, why: str, spec: dict, report: Report, doc, spec_path: Path, path: Path):
-    """Record a searched `home` (`found`: (pose, changes) or None) with one report line and
-    rewrite the spec."""
-    from simkit.importer import writer
-
-    if found is None:
-        return
-    spec["poses"]["home"], changes = found
-    report.assumed(doc, doc.root, f"home: {why}; " + ", ".join(changes) + " rad or m")
-    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
+    source, report = draft.source, draft.report
+    mesh_writer = meshes.MeshWriter(draft.stage)
+    mesh_writer.turn_y_up, why = turn_y_up(source)  # Y_UP COLLADA meshes drawn so: turned
+    if why:
+        report.changed(source, source.root, why)
+    spec = convert.convert(source, name, mesh_writer, report, floating, hull_collision, density)
+    renames = names.make_legal(spec, source, report)
+    draft.renames = renames
+    blocks.keep(spec, source, report, blocks.collect(source), renames)
+    if report.strict and report.problems:
+        first = report.problems[0]
+        first.more = len(report.problems) - 1
+        raise SpecError(first.file, first.line, first.field, first.message, first.more)
+    fits, why = step_fits(spec, draft.stage)
+    if not fits:
+        spec["step"] = False
+        report.changed(source, source.root, why)
+    draft.spec = spec
+    draft.changed()
+    return len(mesh_writer.done)
 
 
 def import_robot(
@@ -143,79 +77,35 @@ def import_robot(
     name: str | None = None,
     package_dirs: tuple[Path, ...] = (),
     strict: bool = False,
-    floating: bool = False,
+    floating: bool | None = None,
     hull_collision: bool = False,
+    density: float | None = None,
     reading: ReadOptions | None = None,
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
-    `hull_collision`: links whose URDF collision has meshes collide with their visual
-    solid's convex hull instead (one piece; reported per link). `reading`: what the reader
-    may do (xacro args, environment, files outside the package; importer/reading.py)."""
-    from simkit.importer import blocks, convert, located, meshes, names, provenance, source, writer
-    from simkit.importer.output import publish, staging
+    `floating`: True or False sets the base; None decides it from the robot's structure
+    (base.py; reported). `hull_collision`: links whose URDF collision has meshes collide
+    with their visual solid's convex hull instead (one piece; reported per link).
+    `density` (kg/m^3, default masses.DENSITY): a massless link's mass from its solid.
+    `reading`: what the reader may do (xacro args, environment, files outside the package;
+    importer/reading.py)."""
+    from simkit.importer import base, fixups, masses, provenance, source, writer
+    from simkit.importer.output import staging
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
     report = Report(strict=strict)
     doc = source.load(path, package_dirs, report, reading)
+    kept = provenance.as_read(doc)  # before any rewrite (spherical joints)
     with staging(out_dir) as stage:  # removed on every way out, SIGTERM included
-        mesh_writer = meshes.MeshWriter(stage)
-        _up_axis(doc, mesh_writer, report)
-        spec = convert.convert(doc, name, mesh_writer, report, floating, hull_collision)
-        renames = names.make_legal(spec, doc, report)
-        blocks.keep(spec, doc, report, blocks.collect(doc), renames)
-        if strict and report.problems:
-            first = report.problems[0]
-            first.more = len(report.problems) - 1
-            raise SpecError(first.file, first.line, first.field, first.message, first.more)
-        _step_budget(spec, stage, report, doc)
-        text = writer.spec_yaml(spec, report.lines, path)
-        (stage / f"{name}.yaml").write_text(text, encoding="utf-8")
-        located.check(stage / f"{name}.yaml", spec, doc, renames)  # before the pose fix-ups
-        if floating:  # stance.py: out of self-contact with the feet kept, then stand
-            text = _stand(spec, report, doc, stage / f"{name}.yaml", path)
-        else:  # home.py: out of self-contact, any joint between touching links may move
-            _free_home(spec, report, doc, stage / f"{name}.yaml", path)
-        _narrow_limits(spec, report, doc, stage / f"{name}.yaml", path)
-        provenance.record(spec, doc, report, renames, stage / f"{name}.yaml", path)
-        located.check(stage / f"{name}.yaml", spec, doc, renames)
-        publish(stage, out_dir)  # each file whole, or one line naming it
-    return Imported(
-        out_dir / f"{name}.yaml", tuple(report.lines), len(mesh_writer.done), len(spec["links"])
-    )
-
-
-def _free_stance(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
-    """Move a floating robot's `home` out of self-contact, feet kept (stance.py); rewrite the
-    spec."""
-    from simkit.importer import stance
-
-    why = (
-        "at the first guess (0, or mid-range outside the limits) links collide or the robot "
-        "cannot rest on the floor"
-    )
-    _new_home(stance.free_home(spec_path), why, spec, report, doc, spec_path, path)
-
-
-def _narrow_limits(spec: dict, report: Report, doc, spec_path: Path, path: Path) -> None:
-    """Estimated position limits narrowed to the joint's range free of self-contact from home
-    (limits.py), one report line per joint; rewrite the spec."""
-    from simkit.importer import limits, writer
-
-    found = limits.narrowed(spec_path)
-    if not found:
-        return
-    for joint in spec["joints"]:
-        if joint["name"] in found:
-            old = (joint["lower"], joint["upper"])
-            joint["lower"], joint["upper"] = found[joint["name"]]
-            element = doc.root.find(f"joint[@name='{joint['name']}']")
-            report.assumed(
-                doc,
-                doc.root if element is None else element,
-                f"estimated limits {old[0]:.4g} .. {old[1]:.4g} narrowed to "
-                f"{joint['lower']:.4g} .. {joint['upper']:.4g}, the range the joint turns "
-                "from home without self-contact",
-            )
-    spec_path.write_text(writer.spec_yaml(spec, report.lines, path), encoding="utf-8")
+        draft = Draft(doc, path, stage, report, kept=kept)
+        draft.legged, why = base.decide(doc)
+        if floating is None:
+            floating = draft.legged
+            draft.report.assumed(doc, doc.root, why)
+        meshes = translate(draft, name, floating, hull_collision, density or masses.DENSITY)
+        for step in fixups.STEPS:
+            step(draft)
+        spec_path = writer.finish(draft, out_dir)
+    return Imported(spec_path, tuple(draft.report.lines), meshes, len(draft.spec["links"]))

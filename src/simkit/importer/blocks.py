@@ -2,9 +2,10 @@
 
 Each block becomes one string of spec `urdf_blocks` (its XML as the file has it, after xacro),
 which the kit's URDF writes back. Names are the one thing that may change: a link or joint the
-importer renamed (names.py) is renamed inside the blocks too. A block naming a link or joint
-the spec does not have (a fixed joint the importer turned into a frame) cannot be written
-back faithfully; it is reported on one line and left out.
+importer renamed (names.py) is renamed inside the blocks too; a fixed joint the importer
+turned into a frame keeps its name (the frame's `joint`). A block naming a link or joint the
+spec does not have cannot be written back faithfully; it is reported on one line and left
+out.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ def keep(spec: dict, source: Source, report: Report, found, renames: dict) -> No
     joints = renames.get("joints", {})
     link_names = {spec["root"], *(x["name"] for x in [*spec["links"], *spec.get("frames", [])])}
     joint_names = {j["name"] for j in spec["joints"]}
+    joint_names |= {f.get("joint") or f"{f['name']}_joint" for f in spec.get("frames", [])}
     kept = []
     for element, text in found:
         try:  # an entity the file's DOCTYPE defines is not defined inside the block

@@ -20,7 +20,7 @@ from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 TOP = ("link", "joint", "material")
 
 
-def _tree(source: Source) -> tuple[dict, dict, str]:
+def tree(source: Source) -> tuple[dict, dict, str]:
     """Links by name, joints by child, and the root link; errors for cycles and orphans."""
     links: dict = {}
     for link in source.root.findall("link"):
@@ -59,11 +59,11 @@ def _tree(source: Source) -> tuple[dict, dict, str]:
         raise source.fail(links[roots[1]], f"links {roots[:3]} have no parent: more than one root")
     reached = {roots[0]}  # every link must reach the root; each link is walked once
     for name in links:
-        path, at = [], name
+        path, at = {}, name  # an insertion-ordered set: linear in the chain's length
         while at not in reached:
             if at in path:
                 raise source.fail(by_child[at], "the joints form a cycle")
-            path.append(at)
+            path[at] = None
             at = by_child[at].find("parent").get("link")
         reached.update(path)
     return links, by_child, roots[0]
@@ -137,15 +137,17 @@ def convert(
     report: Report,
     floating: bool,
     hull_collision: bool = False,
+    density: float | None = None,
 ) -> dict:
-    """The spec dict for the whole robot."""
+    """The spec dict for the whole robot. `density` (kg/m^3): massless links with a solid
+    get its mass at it (`_estimated_mass`; None: the placeholder speck)."""
     for element in source.root:
         if isinstance(element.tag, str) and element.tag not in TOP + URDF_BLOCK_TAGS:
             report.dropped(
                 source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
             )
     expand_ball_joints(source)  # spherical joints: three revolute ones (ball_joints.py)
-    links, by_child, root = _tree(source)
+    links, by_child, root = tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)
     loads = _loads(source, links, kids, by_child, root)
@@ -166,10 +168,22 @@ def convert(
             js = joint_spec(source, joint, report, (0.0, 0.1))
             frame = {"name": link_name, "parent": js["parent"]}
             frame.update({k: js[k] for k in ("xyz", "rpy") if k in js})
+            if js["name"] != f"{link_name}_joint":  # the URDF's own joint name, kept
+                frame["joint"] = js["name"]
             spec_frames.append(frame)
             continue
+        estimate = density if _estimated_mass(link_name, links, by_child) else None
         spec_links.append(
-            link_spec(source, links[link_name], writer, report, materials, colours, hull_collision)
+            link_spec(
+                source,
+                links[link_name],
+                writer,
+                report,
+                materials,
+                colours,
+                hull_collision,
+                estimate,
+            )
         )
         if link_name in by_child:
             spec_joints.append(joint_spec(source, by_child[link_name], report, loads[link_name]))
@@ -204,6 +218,7 @@ def convert(
     movable = [j for j in spec_joints if j["type"] not in ("fixed", "floating")]
     if movable:
         home = {j["name"]: _home(j) for j in movable}
+        _report_mid_range(source, movable, home, report)
         for j in movable:  # a mimic joint follows its leader
             if "mimic" in j and j["mimic"]["joint"] in home:
                 m = j["mimic"]
@@ -224,6 +239,17 @@ def _world(links: dict) -> str:
         count += 1
         name = f"world_frame{count if count > 1 else ''}"
     return name
+
+
+def _estimated_mass(name: str, links: dict, by_child: dict) -> bool:
+    """Whether a massless link's mass comes from its solid (masses.py): always where the URDF
+    gives no link a mass, else for a link on a movable joint (a massless link on a fixed
+    joint is the author's frame or housing, merged into its parent)."""
+    if has_mass(links[name]):
+        return False
+    if not any(has_mass(link) for link in links.values()):
+        return True
+    return name in by_child and by_child[name].get("type") not in ("fixed", None)
 
 
 def _visual_collision(source: Source, spec_links: list[dict], report: Report) -> None:
@@ -310,6 +336,20 @@ def _depth_first(joints: list[dict], root: str, first: set[str] = frozenset()) -
         out.append(joint)
         stack.extend(reversed(by_parent.get(joint["child"], [])))
     return out
+
+
+def _report_mid_range(source: Source, movable: list[dict], home: dict, report: Report) -> None:
+    """One line per joint whose home is not the URDF's zero pose because 0 is outside its
+    limits (a mimic follower follows its leader: none)."""
+    for j in movable:
+        if home[j["name"]] != 0.0 and "mimic" not in j:
+            element = source.root.find(f"joint[@name='{j['name']}']")
+            report.assumed(
+                source,
+                source.root if element is None else element,
+                f"home: {home[j['name']]:.4g}, the middle of its range {j['lower']:.4g} .. "
+                f"{j['upper']:.4g} (the URDF's zero pose is outside it)",
+            )
 
 
 def _home(joint: dict) -> float:

@@ -15,7 +15,7 @@ joints over `AIM` and every non-mimic joint they carry move one at a time to the
 that lowers the summed excess over `AIM` most (the arm hangs, or folds), nearest the current
 value on a tie, never at a limit, never bringing two links closer than the clearance (or
 than at home, where they are closer there) on home.py's model with the visual pieces the
-kit's collision covers (home.covered_shapes). Where no such move is free, one other joint, above
+kit's collision covers (collide.covered_shapes). Where no such move is free, one other joint, above
 them or below, may move too (PR2's torso rises so a lowered arm clears the base). Effort
 numbers are never changed.
 """
@@ -25,6 +25,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
+from simkit.importer import collide
 
 #: share of a joint's effort its static gravity load may take at home (kit page: 80 % rule)
 LIMIT = 0.8
@@ -91,29 +93,27 @@ def _grid(joint, now: float) -> np.ndarray:
     return np.array(sorted(grid, key=lambda v: abs(v - now)))
 
 
-class _Search:
+class Search:
     """The pose being searched: loads (Newton-Euler) and self-contact (MuJoCo) of trials."""
 
-    def __init__(self, spec_path: Path) -> None:
+    def __init__(self, robot, base_dir: Path) -> None:
         import mujoco
 
-        from simkit.importer import home
         from simkit.model.rnea import Tree
 
-        self.robot, self.start, self.follow = home.load(spec_path)
+        self.robot = robot
+        self.start, self.follow = collide.posed(robot)
         self.movable = self.robot.movable_joints
         self.index = {j.name: i for i, j in enumerate(self.movable)}
         self.tree = Tree.of(self.robot) if self.start is not None else None
         self.mujoco = mujoco
-        self.spec_dir = spec_path.parent
+        self.spec_dir = base_dir
 
     def open(self) -> None:
-        """The collision model (home.py's, with the visual pieces: home.covered_shapes) and the
+        """The collision model (collide.py's, with the visual pieces: covered_shapes) and the
         closest distance (m) of each pair of links near each other at the start."""
-        from simkit.importer import home
-
-        always = home._always_touching(self.robot, self.spec_dir, self.start, self.follow)
-        xml = home._model_xml(self.robot, self.spec_dir, always, shapes_of=home.covered_shapes)
+        always = collide.always_touching(self.robot, self.spec_dir, self.start, self.follow)
+        xml = collide.model_xml(self.robot, self.spec_dir, always, shapes_of=collide.covered_shapes)
         self.model = self.mujoco.MjModel.from_xml_string(xml)
         self.data = self.mujoco.MjData(self.model)
         self.adr = np.array(
@@ -125,9 +125,7 @@ class _Search:
         """The smallest distance (m) per pair of geoms closer than the clearance at `q` (per
         geom, not per link: a link's visual piece overlapping at home must not let its
         collision piece sink in)."""
-        from simkit.importer import home
-
-        home._penetration(self.model, self.data, self.adr, q)
+        collide.penetration(self.model, self.data, self.adr, q)
         out: dict[tuple[int, int], float] = {}
         for contact in self.data.contact[: self.data.ncon]:
             pair = (int(contact.geom[0]), int(contact.geom[1]))
@@ -138,13 +136,11 @@ class _Search:
         """No pair of geoms closer than the clearance, or than at the start where they were
         closer already (the kit's collision pieces are not the search's), less `SLACK` for a
         pair overlapping there."""
-        return all(self._allowed(pair, dist) for pair, dist in self._closest(q).items())
+        return all(self.allowed(pair, dist) for pair, dist in self._closest(q).items())
 
-    def _allowed(self, pair: tuple[int, int], dist: float) -> bool:
-        from simkit.importer.home import CLEARANCE
-
+    def allowed(self, pair: tuple[int, int], dist: float) -> bool:
         near = self.near.get(pair, np.inf)
-        return dist >= min(CLEARANCE, near) - (SLACK if near < 0.0 else 1e-6)
+        return dist >= min(collide.CLEARANCE, near) - (SLACK if near < 0.0 else 1e-6)
 
     def loads(self, q: np.ndarray) -> np.ndarray:
         return _loads(self.robot, self.tree, q)[0]
@@ -154,10 +150,8 @@ class _Search:
 
     def moved(self, q: np.ndarray, joint, value: float) -> np.ndarray | None:
         """`q` with `joint` at `value`, mimic joints following; None outside any limit."""
-        from simkit.importer import home
-
         trial = self.follow(np.where(np.arange(len(q)) == self.index[joint.name], value, q))
-        return trial if home._within_limits(self.movable, trial) else None
+        return trial if collide.within_limits(self.movable, trial) else None
 
     def better(self, q: np.ndarray, best: float, joints: list) -> list[np.ndarray]:
         """Every one-joint move of `joints` with less cost than `best`: least cost first,
@@ -183,11 +177,11 @@ class _Search:
         return None
 
 
-def held_home(spec_path: Path) -> tuple[list[float], list[str], str] | None:
+def held_home(robot, base_dir: Path) -> tuple[list[float], list[str], str] | None:
     """(home, changes `joint: a -> b`, why) when some joint's gravity load at the spec's home
     is over `LIMIT` of its effort and a pose with less excess and no more self-contact was
     found; None otherwise."""
-    search = _Search(spec_path)
+    search = Search(robot, base_dir)
     start = search.start
     if start is None:
         return None

@@ -13,259 +13,44 @@ none is left or no move helps. The new pose is kept when no two links touch in i
 
 from __future__ import annotations
 
-import itertools
 import math
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
-#: m: the clearance the chosen pose keeps between non-adjacent links (the kit's collision
-#: pieces are grown a little to cover the visual mesh)
-CLEARANCE = 0.003
+from simkit.importer.collide import (
+    always_touching,
+    between,
+    collision_shapes,
+    covered_shapes,
+    model_xml,
+    penetration,
+    posed,
+    touching,
+    within_limits,
+)
+
 GRID = 8  # range divisions tried per joint
 #: rad or m: turns (slides) from the first guess tried before the grid
 STEPS = 0.05 * 2.0 ** np.arange(6)
 SWEEPS = 3  # moves per joint at most
 
 
-def _text(values) -> str:
-    return " ".join(repr(float(v)) for v in np.ravel(values))
-
-
-def _geom(asset, body, shape, base_dir: Path, name: str) -> None:
-    from simkit.kitio.stl import from_stl
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
-
-    attrs = {"pos": _text(shape.xyz), "quat": _text(quat_wxyz(rpy_matrix(shape.rpy)))}
-    if shape.kind == "mesh":
-        vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
-        ET.SubElement(asset, "mesh", name=name, vertex=_text(vertices))
-        attrs.update(type="mesh", mesh=name)
-    elif shape.kind == "box":
-        attrs.update(type="box", size=_text(np.asarray(shape.size) / 2))
-    elif shape.kind == "sphere":
-        attrs.update(type="sphere", size=_text([shape.radius]))
-    elif shape.kind in ("cylinder", "capsule"):
-        attrs.update(type=shape.kind, size=_text([shape.radius, shape.length / 2]))
-    else:  # a cone: its bounding cylinder
-        attrs.update(
-            type="cylinder",
-            size=_text([max(shape.radius, shape.radius_top or 0), shape.length / 2]),
-        )
-    ET.SubElement(body, "geom", attrs)
-
-
-def _shapes(link) -> tuple:
-    """The shapes whose hulls stand for the link's collision geometry in the kit."""
-    if link.collision_method == "primitives":  # none when the URDF gives no collision
-        return link.collision_primitives
-    if link.collision_shapes:
-        return link.collision_shapes
-    return link.shapes
-
-
-def covered_shapes(link) -> tuple:
-    """Collision shapes and, for a link that has some, its visual pieces too: the kit grows
-    its collision pieces to cover the visual (a link without collision has none in the kit)."""
-    given = tuple(_shapes(link))
-    return given + tuple(s for s in link.shapes if s not in given) if given else ()
-
-
-def _adjacent(robot) -> set[tuple[str, str]]:
-    """Links joined by a joint, or through links without geometry (the kit's exclusions)."""
-    near: dict[str, set[str]] = {}
-    for joint in robot.joints:
-        near.setdefault(joint.parent, set()).add(joint.child)
-        near.setdefault(joint.child, set()).add(joint.parent)
-    solid = {link.name for link in robot.links if _shapes(link)}
-    for node in sorted(set(near) - solid):
-        around = near.pop(node)
-        for other in around:
-            near[other].discard(node)
-        for a, b in itertools.combinations(sorted(around), 2):
-            near[a].add(b)
-            near[b].add(a)
-    return {tuple(sorted((a, b))) for a in solid for b in near.get(a, ()) if b in solid}
-
-
-def add_bodies(root: ET.Element, robot, base_dir: Path, shapes_of, geom) -> None:
-    """The robot's body tree under `root`'s worldbody (unit masses; hinge or slide joints),
-    each link with a geom per shape `shapes_of(link)` gives, written by `geom`: the
-    collision-only MuJoCo model the home (here) and stance (stance.py) searches use."""
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
-
-    asset = ET.SubElement(root, "asset")
-    bodies = {robot.root: ET.SubElement(root, "worldbody")}
-    for joint in robot.joints:
-        link = robot.link(joint.child)
-        quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
-        body = ET.SubElement(
-            bodies[joint.parent], "body", name=link.name, pos=_text(joint.xyz), quat=quat
-        )
-        bodies[link.name] = body
-        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
-        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
-        if kind:
-            ET.SubElement(body, "joint", name=joint.name, type=kind, axis=_text(joint.axis))
-        for i, shape in enumerate(shapes_of(link)):
-            geom(asset, body, shape, base_dir, f"{link.name}_{i}")
-
-
-def _model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=_shapes) -> str:
-    """The search's collision-only MJCF: geoms from `shapes_of(link)` with half the clearance
-    as margin each, joined links and `also_excluded` pairs excluded, no parent filter."""
-
-    root = ET.Element("mujoco")
-    ET.SubElement(root, "compiler", angle="radian")
-    ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable")
-    margin = _text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
-    ET.SubElement(
-        ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
-    )
-    add_bodies(root, robot, base_dir, shapes_of, _geom)
-    contact = ET.SubElement(root, "contact")
-    for a, b in sorted(_adjacent(robot) | set(also_excluded)):
-        ET.SubElement(contact, "exclude", body1=a, body2=b)
-    return ET.tostring(root, encoding="unicode")
-
-
-def _penetration(model, data, adr, q) -> tuple[float, set[tuple[str, str]]]:
-    """How far (m, summed over contacts) links are inside the clearance, and the link pairs."""
-    import mujoco
-
-    data.qpos[adr] = q
-    mujoco.mj_kinematics(model, data)
-    mujoco.mj_collision(model, data)
-    depth, pairs = 0.0, set()
-    for i in range(data.ncon):
-        if data.contact.dist[i] < CLEARANCE:
-            depth += CLEARANCE - float(data.contact.dist[i])
-            g1, g2 = data.contact.geom[i]
-            pairs.add(
-                (model.body(model.geom_bodyid[g1]).name, model.body(model.geom_bodyid[g2]).name)
-            )
-    return depth, pairs
-
-
-def _touching(data) -> bool:
-    """True when the last `_penetration` found two links touching or overlapping."""
-    return bool((data.contact.dist[: data.ncon] <= 0.0).any())
-
-
-def _between(robot, a: str, b: str) -> list:
-    """The movable joints on the tree path between links `a` and `b`, distal first."""
-    parent = {j.child: j for j in robot.joints}
-
-    def up(node: str) -> list:
-        out = []
-        while node in parent:
-            out.append(parent[node])
-            node = parent[node].parent
-        return out
-
-    ua, ub = up(a), up(b)
-    common = {j.name for j in ua} & {j.name for j in ub}
-    return [j for j in ua + ub if j.name not in common and j.movable and j.mimic is None]
-
-
-#: random configurations (seeded) a pair's contact is counted in to tell an always pair
-ALWAYS_SAMPLES = 200
-#: the share of them it must touch in, and m: closer than this touches (the kit's rule,
-#: derive/collision_pairs.py ALWAYS_FRACTION and TOUCH: MoveIt Setup Assistant's "Always")
-ALWAYS_FRACTION = 0.95
-TOUCH = 1e-6
-
-
-def _contacts(model, data, adr, q) -> set[tuple[str, str]]:
-    """Link pairs (sorted names) touching or closer than `TOUCH` at `q`."""
-    _penetration(model, data, adr, q)
-    out = set()
-    for i in range(data.ncon):
-        if data.contact.dist[i] < TOUCH:
-            g1, g2 = data.contact.geom[i]
-            a = model.body(model.geom_bodyid[g1]).name
-            b = model.body(model.geom_bodyid[g2]).name
-            out.add((a, b) if a < b else (b, a))
-    return out
-
-
-def _always_touching(robot, base_dir: Path, start: np.ndarray, follow, shapes_of=_shapes) -> tuple:
-    """Link pairs touching at the first guess and in at least `ALWAYS_FRACTION` of
-    `ALWAYS_SAMPLES` seeded random configurations: URDF collision shapes that overlap wherever
-    (or almost wherever) the joints are (Panda collision primitives of links 1 and 3, TIAGo's
-    fingertips in the hand's safety box, Baxter's finger blocks face on face). The kit
-    excludes such pairs (derive collision_pairs "always", as MoveIt Setup Assistant does), so
-    no pose can or need separate them; the search must not try, or it never moves the pair it
-    could fix."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir, shapes_of=shapes_of))
-    data = mujoco.MjData(model)
-    movable = robot.movable_joints
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
-    pairs = _contacts(model, data, adr, start)
-    rng = np.random.default_rng(robot.seed)
-    low = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
-    high = np.array([j.upper if j.upper is not None else math.pi for j in movable])
-    allowed = ALWAYS_SAMPLES - math.ceil(ALWAYS_FRACTION * ALWAYS_SAMPLES - 1e-9)
-    misses = dict.fromkeys(pairs, 0)
-    for _ in range(ALWAYS_SAMPLES if pairs else 0):
-        found = _contacts(model, data, adr, follow(rng.uniform(low, high)))
-        for p in misses:
-            misses[p] += p not in found
-    return tuple(sorted(p for p, n in misses.items() if n <= allowed))
-
-
-def _within_limits(movable, q: np.ndarray) -> bool:
-    """Every joint of `q` (spec order) inside its limits (a mimic joint has its own)."""
-    return all(
-        (j.lower is None or value >= j.lower - 1e-9)
-        and (j.upper is None or value <= j.upper + 1e-9)
-        for j, value in zip(movable, q, strict=True)
-    )
-
-
-def load(spec_path: Path):
-    """(robot, home or None when it has no movable joint, follow): the written spec resolved,
-    its home (spec order), and a function setting mimic joints of a pose from their leaders."""
-    import yaml
-
-    from simkit.model.resolve import resolve
-    from simkit.spec.schema import RobotSpec
-
-    text = spec_path.read_text(encoding="utf-8")
-    robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
-    movable = robot.movable_joints
-    index = {j.name: i for i, j in enumerate(movable)}
-
-    def follow(q: np.ndarray) -> np.ndarray:  # mimic joints follow their leaders
-        for j in movable:
-            if j.mimic is not None and j.mimic[0] in index:
-                leader, multiplier, offset = j.mimic
-                q[index[j.name]] = multiplier * q[index[leader]] + offset
-        return q
-
-    poses = dict(robot.poses)
-    start = np.array(poses["home"], dtype=float) if "home" in poses else None
-    return robot, start, follow
-
-
-def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
+def free_home(robot, base_dir: Path, every: bool = False) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) with no self-contact and the changes made (`joint: a -> b`),
     or None when the spec's home is already free or the search finds no free pose. Only the
     joints between two links in contact move, each to the grid value that leaves the least
     penetration, the one nearest the first guess on a tie. A second search, from the first
     one's pose, adds the links' visual pieces (covered_shapes), which the kit's collision pieces
     are grown to cover (Alex's Sake fingers, whose collision meshes sit apart from their
-    visual ones, touch only there)."""
+    visual ones, touch only there). `every`: pairs touching almost everywhere count too."""
 
-    robot, start, follow = load(spec_path)
+    start, follow = posed(robot)
     if start is None:  # no movable joint: nothing to move
         return None
     q = start
-    for shapes_of in (_shapes, covered_shapes):
-        q = _search(robot, spec_path.parent, q, follow, shapes_of)
+    for shapes_of in (collision_shapes, covered_shapes):
+        q = _search(robot, base_dir, q, follow, shapes_of, every)
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"
         for i, j in enumerate(robot.movable_joints)
@@ -274,23 +59,23 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     return ([float(f"{v:.6g}") for v in q], changes) if changes else None
 
 
-def _search(robot, base_dir: Path, start: np.ndarray, follow, shapes_of) -> np.ndarray:
+def _search(robot, base_dir: Path, start, follow, shapes_of, every: bool = False) -> np.ndarray:
     """A pose free of contact on the model of `shapes_of`, from `start` (see free_home);
     `start` when it is free already or no free pose is found."""
     import mujoco
 
     movable = robot.movable_joints
     index = {j.name: i for i, j in enumerate(movable)}
-    always = _always_touching(robot, base_dir, start, follow, shapes_of)
-    model = mujoco.MjModel.from_xml_string(_model_xml(robot, base_dir, always, shapes_of))
+    always = () if every else always_touching(robot, base_dir, start, follow, shapes_of)
+    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, always, shapes_of))
     data = mujoco.MjData(model)
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
     q = start.copy()
-    best, pairs = _penetration(model, data, adr, q)
-    if not _touching(data):  # closer than the clearance is fine at the first guess
+    best, pairs = penetration(model, data, adr, q)
+    if not touching(data):  # closer than the clearance is fine at the first guess
         return start
     for _ in range(SWEEPS * len(movable)):
-        joints = {j.name: j for a, b in sorted(pairs) for j in _between(robot, a, b)}
+        joints = {j.name: j for a, b in sorted(pairs) for j in between(robot, a, b)}
         moved = False
         for j in joints.values():
             lo, hi = (j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi)
@@ -301,14 +86,31 @@ def _search(robot, base_dir: Path, start: np.ndarray, follow, shapes_of) -> np.n
             grid = grid[(grid > lo + 1e-6) & (grid < hi - 1e-6)]
             for value in sorted(grid, key=lambda v: abs(v - start[i])):
                 trial = follow(np.where(np.arange(len(q)) == i, value, q))
-                if not _within_limits(movable, trial):  # a mimic follower left its range
+                if not within_limits(movable, trial):  # a mimic follower left its range
                     continue
-                depth, found = _penetration(model, data, adr, trial)
+                depth, found = penetration(model, data, adr, trial)
                 if depth < best - 1e-9:
                     q, best, pairs, moved = trial, depth, found, True
             if moved:
                 break
         if best == 0.0 or not moved:
             break
-    _penetration(model, data, adr, q)
-    return start if _touching(data) else q  # no free pose found: the first guess stays
+    penetration(model, data, adr, q)
+    return start if touching(data) else q  # no free pose found: the first guess stays
+
+
+def in_contact(robot, base_dir: Path) -> bool:
+    """Whether two links that the kit lets collide touch at the spec's home (the first
+    search's model: collision shapes, the always-touching pairs left out)."""
+    import mujoco
+
+    start, follow = posed(robot)
+    if start is None:
+        return False
+    always = always_touching(robot, base_dir, start, follow, collision_shapes)
+    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, always, collision_shapes))
+    data = mujoco.MjData(model)
+    movable = robot.movable_joints
+    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    penetration(model, data, adr, start)
+    return touching(data)

@@ -14,10 +14,6 @@ KNOWN = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 #: rad/s and m/s given to a joint without a velocity limit
 VELOCITY = {"revolute": 3.0, "continuous": 3.0, "prismatic": 0.5}
 G = 9.81
-#: kg m^2 per N m of effort (kg per N for prismatic): the estimated armature (reflected rotor
-#: inertia). With simkit's servo (kp = effort per 0.01 rad) it bounds the servo's frequency
-#: to sqrt(100 / 1e-3) = 316 rad/s, 0.63 rad per 2 ms step: stable however light the link.
-ARMATURE_PER_EFFORT = 1.0e-3
 
 
 def joint_spec(source: Source, joint, report: Report, load: tuple[float, float]) -> dict:
@@ -140,16 +136,6 @@ def _limits(
         )
         estimated.append("effort_peak")
     out["effort_peak"] = effort
-    if joint.find("mimic") is None:
-        armature = float(f"{ARMATURE_PER_EFFORT * effort:.3g}")
-        report.assumed(
-            source,
-            element,
-            f"no armature in a URDF: {armature:g} ({ARMATURE_PER_EFFORT:g} x effort, a geared "
-            "motor's reflected rotor inertia; keeps the servo stable on light links)",
-        )
-        out["armature"] = armature
-        estimated.append("armature")
     return out
 
 

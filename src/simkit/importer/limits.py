@@ -7,9 +7,9 @@ double pendulum's second link folds onto the base at -180 deg. The kit's self-co
 estimate must be the free range, not a turn.
 
 Each such joint is swept from home towards each limit, the others at home (mimic followers
-follow), in `STEP` steps on the import's collision model (home.py: the links' collision
+follow), in `STEP` steps on the import's collision model (collide.py: the links' collision
 shapes, plus their visual pieces, which the kit's collision pieces are grown to cover); the
-first sample where two links come closer than `home.CLEARANCE` ends the range, and the limit is
+first sample where two links come closer than `collide.CLEARANCE` ends the range, and the limit is
 set `BACK_OFF` steps short of it. Published (URDF) limits are never changed.
 """
 
@@ -20,24 +20,24 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.importer import collide
+
 STEP = {"revolute": math.radians(0.5), "prismatic": 0.001}  # rad, m
 BACK_OFF = 2  # steps kept clear of the first contact (the check sweeps in 2 deg steps)
 DIGITS = 4  # decimals of a narrowed limit, rounded towards home
 
 
-def narrowed(spec_path: Path) -> dict[str, tuple[float, float]]:
+def narrowed(robot, base_dir: Path) -> dict[str, tuple[float, float]]:
     """{joint: (lower, upper)} for each joint whose estimated limits were narrowed (rad or
     m), none when home itself is in contact (nothing to measure a free range from)."""
     import mujoco
 
-    from simkit.importer import home
-
-    robot, start, follow = home.load(spec_path)
+    start, follow = collide.posed(robot)
     if start is None:
         return {}
-    always = home._always_touching(robot, spec_path.parent, start, follow)
+    always = collide.always_touching(robot, base_dir, start, follow)
     model = mujoco.MjModel.from_xml_string(
-        home._model_xml(robot, spec_path.parent, always, shapes_of=home.covered_shapes)
+        collide.model_xml(robot, base_dir, always, shapes_of=collide.covered_shapes)
     )
     data = mujoco.MjData(model)
     movable = robot.movable_joints
@@ -61,9 +61,7 @@ def narrowed(spec_path: Path) -> dict[str, tuple[float, float]]:
 
 def _closest(model, data, adr, q) -> dict[tuple[int, int], float]:
     """The smallest distance (m) per body pair closer than the search clearance at `q`."""
-    from simkit.importer import home
-
-    home._penetration(model, data, adr, q)
+    collide.penetration(model, data, adr, q)
     out: dict[tuple[int, int], float] = {}
     for contact in data.contact[: data.ncon]:
         pair = tuple(sorted(int(model.geom_bodyid[g]) for g in contact.geom))
@@ -75,11 +73,10 @@ def _blocked_against(model, data, adr, near: dict):
     """A test of a pose: a pair comes closer than the clearance, or, for pairs already that
     close at home (home.py keeps them apart, not a clearance apart), closer than half their
     distance at home."""
-    from simkit.importer import home
 
     def blocked(q: np.ndarray) -> bool:
         for pair, dist in _closest(model, data, adr, q).items():
-            if dist < min(home.CLEARANCE, 0.5 * near.get(pair, math.inf)):
+            if dist < min(collide.CLEARANCE, 0.5 * near.get(pair, math.inf)):
                 return True
         return False
 

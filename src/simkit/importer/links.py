@@ -130,10 +130,14 @@ def link_spec(
     materials: dict[str, tuple],
     colours: dict[tuple, str],
     hull_collision: bool = False,
+    density: float | None = None,
 ) -> dict:
-    """The spec dict of one link. `colours` maps rgba -> material name (filled here)."""
+    """The spec dict of one link. `colours` maps rgba -> material name (filled here).
+    `density` (kg/m^3): a massless link gets the mass of its solid at it (masses.py)."""
     name = link.get("name")
-    spec: dict = {"name": name, **inertial(source, link, report)}
+    spec: dict = {"name": name}
+    if has_mass(link) or density is None:
+        spec.update(inertial(source, link, report))
     for child in link:
         if isinstance(child.tag, str) and child.tag not in KNOWN:
             report.dropped(source, child, "not a URDF link element simkit keeps")
@@ -169,6 +173,8 @@ def link_spec(
     used = {s["file"] for s in solid if s["shape"] == "mesh"}
     if any(i.file in used and i.repair == "hull" for i in writer.done.values()):
         spec["estimated"] = [*spec.get("estimated", []), "solid"]
+    if "mass" not in spec:  # massless, its mass estimated from the solid
+        spec.update(_from_solid(source, link, report, solid, writer, density))
     if solid:
         spec["solid"] = solid
     if rgba is not None:
@@ -180,6 +186,32 @@ def link_spec(
         report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
     spec.update(chosen)
     return spec
+
+
+def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dict:
+    """A massless link's mass, CoM and inertia: its visual solid's at `density` (kg/m^3),
+    estimated and reported; the placeholder speck (`inertial`) where it has no volume."""
+    from simkit.importer.masses import solid_mass
+
+    found = solid_mass(solid, writer.out_dir, density) if solid else None
+    if found is None or found[0] < MIN_MASS:
+        return inertial(source, link, report)
+    mass, com, tensor, volume, what = found
+    report.estimated(
+        source,
+        link,
+        f"no mass in the URDF: {mass:.4g} kg, its visual solid's volume ({volume:.4g} m^3, "
+        f"{what}) at {density:g} kg/m^3 (--density); CoM and inertia of that solid",
+    )
+    flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
+    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    return {
+        "mass": float(f"{mass:.6g}"),
+        "com": [float(f"{c:.6g}") + 0.0 for c in com],
+        "inertia": {k: float(f"{v:.9g}") + 0.0 for k, v in zip(keys, flat, strict=True)},
+        "estimated": ["mass", "com", "inertia"],
+        "note": f"massless in the URDF; mass of its visual solid at {density:g} kg/m^3",
+    }
 
 
 #: up to this many collision elements are kept as the link's pieces (one convex hull each)

@@ -29,18 +29,19 @@ def _spelled(name: str) -> str:
     return out[: MAX_NAME - 8]
 
 
-def _problems(spec: dict) -> dict[tuple[str, int], str]:
-    """(list key, index) -> why, for each link, joint or frame name the spec refuses."""
+def _problems(spec: dict) -> dict[tuple[str, int, str], str]:
+    """(list key, index, field) -> why, for each link, joint or frame name (or a frame's
+    URDF joint name) the spec refuses."""
     from types import SimpleNamespace
 
     from simkit.spec.names import problems
 
-    out: dict[tuple[str, int], str] = {}
+    out: dict[tuple[str, int, str], str] = {}
     for loc, why in problems(SimpleNamespace(**_construct(spec))):
-        if len(loc) == 3 and loc[0] in _REFS and loc[2] == "name":
-            out.setdefault((str(loc[0]), int(loc[1])), why)
+        if len(loc) == 3 and loc[0] in _REFS and loc[2] in ("name", "joint"):
+            out.setdefault((str(loc[0]), int(loc[1]), str(loc[2])), why)
         elif tuple(loc) == ("root",):  # a root frame (massless URDF root) is no list item
-            out.setdefault(("root", -1), why)
+            out.setdefault(("root", -1, "name"), why)
     return out
 
 
@@ -49,7 +50,10 @@ def _construct(spec: dict) -> dict:
     from types import SimpleNamespace as NS
 
     keys = ("links", "joints", "frames", "materials", "planning_groups")
-    out: dict = {k: [NS(name=item["name"]) for item in spec.get(k, [])] for k in keys}
+    out: dict = {
+        k: [NS(name=item["name"], joint=item.get("joint")) for item in spec.get(k, [])]
+        for k in keys
+    }
     out.update(name=spec["name"], root=spec["root"], poses={}, poses_deg={}, mjcf=None)
     out.update(freefall=None, wrist_centre=None, tool_frame=None)
     return out
@@ -66,22 +70,26 @@ def make_legal(spec: dict, source: Source, report: Report) -> dict[str, dict[str
         if not bad:
             return final
         taken = {n.lower() for key in _REFS for n in (i["name"] for i in spec.get(key, []))}
+        taken |= {f["joint"].lower() for f in spec.get("frames", []) if f.get("joint")}
         renames: dict[str, dict[str, str]] = {}
-        for (key, index), why in sorted(bad.items()):
-            old = spec["root"] if key == "root" else spec[key][index]["name"]
-            key = "frames" if key == "root" else key  # renamed like a frame, root included
+        for (key, index, field), why in sorted(bad.items()):
+            if key == "root":  # renamed like a frame
+                old, kind = spec["root"], "frames"
+            else:
+                old = spec[key][index][field]
+                kind = "joints" if field == "joint" else key  # a frame's joint is a joint name
             new = _spelled(old)
             if new == old or new.lower() in taken:
-                new = f"{new}{_SUFFIX[key]}"
+                new = f"{new}{_SUFFIX[kind]}"
             count = 2
             base = new
             while new.lower() in taken:
                 new, count = f"{base}{count}", count + 1
             taken.add(new.lower())
-            renames.setdefault(key, {})[old] = new
+            renames.setdefault(kind, {})[old] = new
             original[new] = urdf = original.get(old, old)
-            final.setdefault(key, {})[urdf] = new
-            tag = "joint" if key == "joints" else "link"
+            final.setdefault(kind, {})[urdf] = new
+            tag = "joint" if kind == "joints" else "link"
             element = next((e for e in source.root.iter(tag) if e.get("name") == urdf), None)
             report.changed(source, element, f"renamed to '{new}' ({why})")
         _apply(spec, renames)
@@ -97,6 +105,8 @@ def _apply(spec: dict, renames: dict[str, dict[str, str]]) -> None:
             for field in fields:
                 table = joints if key == "joints" and field == "name" else links
                 item[field] = table.get(item[field], item[field])
+            if key == "frames" and item.get("joint"):
+                item["joint"] = joints.get(item["joint"], item["joint"])
             mimic = item.get("mimic")
             if mimic is not None:
                 mimic["joint"] = joints.get(mimic["joint"], mimic["joint"])

@@ -12,7 +12,6 @@ URDF's names: `links.L.FIELD`, `joints.J.FIELD`, `links.L.name` (renamed, `kit` 
 from __future__ import annotations
 
 import hashlib
-from pathlib import Path
 
 from simkit.importer.report import Report
 from simkit.importer.source import Source, describe, line_of
@@ -40,27 +39,30 @@ def source_name(spec: dict) -> str:
     return f"{spec['name']}.source.urdf"
 
 
-def record(
-    spec: dict,
-    source: Source,
-    report: Report,
-    renames: dict[str, dict[str, str]],
-    spec_path: Path,
-    urdf_path: Path,
-) -> None:
-    """Write the kept source beside `spec_path`, add `source` and `source_differences` to
-    `spec` and rewrite the spec file (its header keeps the report lines)."""
+def as_read(source: Source) -> Source:
+    """The URDF as the importer read it (xacro expanded), copied before any rewrite (a
+    spherical joint becomes three joints in place, ball_joints.py): what the kit is
+    compared with. Line numbers are kept, so report lines still match its elements."""
+    import copy
+    from dataclasses import replace
+
+    return replace(source, root=copy.deepcopy(source.root))
+
+
+def keep(draft) -> None:
+    """Write the kept source into the draft's staging folder and add `source` and
+    `source_differences` to its spec (the last step before writer.finish writes it)."""
     from lxml import etree
 
-    from simkit.importer import writer
-
-    data = etree.tostring(source.root.getroottree(), xml_declaration=True, encoding="utf-8")
+    original = draft.kept
+    data = etree.tostring(original.root.getroottree(), xml_declaration=True, encoding="utf-8")
     data = data.rstrip(b"\n") + b"\n"
+    spec = draft.spec
     name = source_name(spec)
-    (spec_path.parent / name).write_bytes(data)
+    (draft.stage / name).write_bytes(data)
     spec["source"] = {"file": name, "sha256": hashlib.sha256(data).hexdigest()}
-    spec["source_differences"] = differences(spec, source, report, renames)
-    spec_path.write_text(writer.spec_yaml(spec, report.lines, urdf_path), encoding="utf-8")
+    spec["source_differences"] = differences(spec, original, draft.report, draft.renames)
+    draft.changed()
 
 
 def differences(
@@ -82,6 +84,7 @@ def differences(
             add(f"{key}.{old}.name", f"renamed: '{old}' is not a name the kit can hold", new)
     _added(spec, source, back, add)
     _frames(spec, source, back, add)
+    _reshaped(spec, source, report, back, add)
     for kind, fields in COMPARED.items():
         tag = kind[:-1]
         for item in spec.get(kind, []):
@@ -109,6 +112,31 @@ def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
         if joint["parent"] == root and joint["type"] == "fixed":
             add(f"links.{root}", "added: the world the fixed base is bolted to")
             add(f"joints.{joint['name']}", "added: bolts the URDF's root link to the world")
+
+
+#: joint fields the source check compares, listed for a joint the kit had to reshape
+RESHAPED = ("parent", "origin", "axis", "lower", "upper", "max_velocity", "effort_peak")
+
+
+def _reshaped(spec: dict, source: Source, report: Report, back: dict[str, str], add) -> None:
+    """A URDF joint of a type the kit has no equivalent for (PyBullet's `spherical`) becomes
+    several kit joints through links the URDF lacks: the URDF joint's compared fields, and
+    each kit link or joint the URDF lacks, are listed with the import's report line."""
+    kinds = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
+    for element in source.root.iter("joint"):
+        if element.get("type") in kinds:
+            continue
+        said = _said(report, source, element) or f"a {element.get('type')} joint in the URDF"
+        name = element.get("name")
+        for field in RESHAPED:
+            add(f"joints.{name}.{field}", said)
+        for kind, tag in (("links", "link"), ("joints", "joint")):
+            for item in spec.get(kind, []):
+                old = back.get(item["name"], item["name"])
+                if source.root.find(f"{tag}[@name='{_quoted(old)}']") is None and (
+                    old.startswith(name)
+                ):
+                    add(f"{kind}.{old}", f"added: {said}")
 
 
 def _frames(spec: dict, source: Source, back: dict[str, str], add) -> None:

@@ -9,9 +9,12 @@ shapes stance.py collides, floor contact only: home is free of self-contact alre
 the spec's real masses and inertias, each actuated joint held at home by a position servo
 as the kit's (kp = effort per 0.01 rad, force limited to the effort). Where the robot comes
 to rest tilted (more than `TILT`) with its frame (the base or a link welded to it) on the
-floor, and each servo holds its joint with at most `LIMIT` of its effort (the static torque
-the contact forces leave it), the settled pose becomes the free joint's origin, so the kit
-starts where the robot rests. Legged robots standing on their feet keep their level base.
+floor, the robot must not rest leaning: the search takes the pose (home, else a seeded
+candidate) on which it rests within `UPRIGHT` of level on its frame, each servo holding its
+joint with at most `LIMIT` of its effort (the static torque the contact forces leave it); the
+settled pose becomes the free joint's origin, so the kit starts where the robot rests. Where
+no pose rests so, the base stays level (standing.py). Legged robots standing on their feet
+keep their level base.
 """
 
 from __future__ import annotations
@@ -26,6 +29,8 @@ import numpy as np
 SECONDS = 2.0  # s of settling
 TIMESTEP = 0.002  # s, as the kit's MJCF
 TILT = 0.02  # rad: a settled base turned less than this stays level
+#: rad: the most a floating base may rest tilted (issue 22: it stands within 5 deg of upright)
+UPRIGHT = math.radians(5.0)
 LIMIT = 0.8  # share of its effort a servo may need to hold the rest (kit page: 80 % rule)
 CANDIDATES = 48  # seeded random poses tried where home does not rest within LIMIT
 EDGE = 0.05  # share of a joint's range at each end no candidate is drawn from
@@ -52,8 +57,9 @@ class Rest:
         return max(self.loads.items(), key=lambda kv: (kv[1], kv[0]), default=("", 0.0))
 
     def holds(self) -> bool:
-        """Resting, frame down, tilted, every servo within LIMIT: worth starting from."""
-        return self.still and self.frame_down and self.tilt > TILT and self.worst[1] <= LIMIT
+        """Resting, frame down, within UPRIGHT of level, every servo within LIMIT: worth
+        starting from."""
+        return self.still and self.frame_down and self.tilt <= UPRIGHT and self.worst[1] <= LIMIT
 
 
 def _text(values) -> str:
@@ -85,8 +91,8 @@ def _principal(tensor) -> dict[str, str]:
 
 def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Element:
     """A body with the link's real inertial and its collision shapes (floor contact only)."""
-    from simkit.importer.home import _geom
-    from simkit.importer.stance import _shapes
+    from simkit.importer.collide import geom
+    from simkit.importer.stance import stance_shapes
 
     body = ET.SubElement(parent, "body", name=link.name, **attrs)
     inertial = link.inertial
@@ -100,8 +106,8 @@ def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Elemen
         )
     else:  # a massless link: a speck, so MuJoCo accepts a moving body
         ET.SubElement(body, "inertial", pos="0 0 0", mass="1e-6", diaginertia="1e-9 1e-9 1e-9")
-    for i, shape in enumerate(_shapes(link)):
-        _geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+    for i, shape in enumerate(stance_shapes(link)):
+        geom(asset, body, shape, base_dir, f"{link.name}_{i}")
     return body
 
 
@@ -172,7 +178,7 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
             "position",
             name=joint.name,
             joint=joint.name,
-            kp=repr(SERVO_STIFFNESS * effort),
+            kp=repr(joint.kp or SERVO_STIFFNESS * effort),  # a softened servo: masses.py
             dampratio="1",
             forcerange=_text([-effort, effort]),
         )
@@ -187,29 +193,29 @@ class Settler:
     def __init__(self, robot, base_dir: Path, home, follow):
         import mujoco
 
-        from simkit.importer.home import _always_touching
-        from simkit.importer.stance import _shapes, _Support
+        from simkit.importer.collide import always_touching
+        from simkit.importer.stance import Support, stance_shapes
 
         home = np.asarray(home, dtype=float)
         self.robot, self.base_dir, self.follow = robot, base_dir, follow
-        self.excluded = _always_touching(robot, base_dir, home, follow, _shapes)
+        self.excluded = always_touching(robot, base_dir, home, follow, stance_shapes)
         self.model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, home, self.excluded))
         joint = lambda name: self.model.jnt_qposadr[self.model.joint(name).id]  # noqa: E731
         self.adr = np.array([joint(j.name) for j in robot.movable_joints], dtype=int)
         self.servos = _servos(robot)
         self.servo_adr = np.array([joint(j.name) for j in self.servos], dtype=int)
-        self.frame = _Support(robot, base_dir).frame
+        self.frame = Support(robot, base_dir).frame
         self.free = self.model.jnt_qposadr[self.model.joint(robot.floating_joint.name).id]
 
     def height(self, q) -> float:
         """m the base's origin stands above the floor at `q`, the base at its rotation."""
-        from simkit.importer.standing import _lowest, floor_shapes
+        from simkit.importer.standing import floor_shapes, lowest
         from simkit.model.kinematics import forward
 
         poses = forward(self.robot, list(q))
         base = poses[self.robot.floating_joint.child][2, 3]
         low = [
-            _lowest(shape, poses[link.name], self.base_dir)
+            lowest(shape, poses[link.name], self.base_dir)
             for link in self.robot.links
             for shape in floor_shapes(link)
         ]
@@ -258,7 +264,7 @@ class Settler:
 
         robot = self.robot
         movable = robot.movable_joints
-        model = mujoco.MjModel.from_xml_string(stance._model_xml(robot, self.base_dir))
+        model = mujoco.MjModel.from_xml_string(stance.model_xml(robot, self.base_dir))
         data = mujoco.MjData(model)
         adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
         lo = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
@@ -270,7 +276,7 @@ class Settler:
             for q in (self.follow(d) for d in draws)
             if all(
                 p in self.excluded or depth <= stance.TOUCH
-                for p, depth in stance._contacts(model, data, adr, q).items()
+                for p, depth in stance.contacts(model, data, adr, q).items()
             )
         ]
         home = np.asarray(home, dtype=float)
@@ -286,17 +292,17 @@ def _rpy(quat) -> tuple[float, float, float]:
     return tuple(float(v) for v in Rotation.from_quat([x, y, z, w]).as_euler("xyz"))
 
 
-def rest_pose(spec_path: Path) -> tuple[list[float], Rest, str] | None:
+def rest_pose(robot, base_dir: Path) -> tuple[list[float], Rest, str] | None:
     """Where a robot that tips onto its frame at home comes to rest: home where its servos
     hold that rest within LIMIT, else the seeded candidate pose (Settler.candidates) whose
     rest needs the least of any servo's effort; the pose, its rest and one report line.
     None where the robot stands level at home (legs), or no candidate rests within LIMIT."""
-    from simkit.importer.home import load
+    from simkit.importer.collide import posed
 
-    robot, home, follow = load(spec_path)
+    home, follow = posed(robot)
     if robot.floating_joint is None or home is None or not _servos(robot):
         return None
-    settler = Settler(robot, spec_path.parent, home, follow)
+    settler = Settler(robot, base_dir, home, follow)
     first = settler.run(home)
     if first.tilt <= TILT or not first.frame_down:  # level on its feet: standing.py's stance
         return None

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.home import _geom  # one collision-model writer for both searches
+from simkit.importer.collide import add_bodies, between, geom
 
 GRID = 8  # range divisions tried per joint
 SWEEPS = 2
@@ -36,19 +36,17 @@ PAIR_JOINTS = 3  # joints next to a stuck pair moved two at a time
 PAIR_GRID = 24  # values per joint in that search  # random poses tried for one the robot rests on
 
 
-def _shapes(link) -> tuple:
+def stance_shapes(link) -> tuple:
     return link.collision_primitives or link.collision_shapes or link.shapes
 
 
-def _model_xml(robot, base_dir: Path) -> str:
+def model_xml(robot, base_dir: Path) -> str:
     """Collision geometry only; every body but a fixed joint's child moves (fixed children
     are welded, as MuJoCo does in the kit), the parent filter on."""
-    from simkit.importer.home import add_bodies
-
     root = ET.Element("mujoco")
     ET.SubElement(root, "compiler", angle="radian")
     ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
-    add_bodies(root, robot, base_dir, _shapes, _geom)
+    add_bodies(root, robot, base_dir, stance_shapes, geom)
     contact = ET.SubElement(root, "contact")
     links = {link.name for link in robot.links}
     for joint in robot.joints:
@@ -57,7 +55,7 @@ def _model_xml(robot, base_dir: Path) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def _contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
+def contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
     """Deepest penetration (m, > 0) per touching body pair at `q`."""
     import mujoco
 
@@ -75,14 +73,14 @@ def _contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
 
 def _feet_joints(robot, home, base_dir: Path) -> set[str]:
     """Joints on the way from the base to any link whose lowest point at home is a foot."""
-    from simkit.importer.standing import _points, floor_shapes
+    from simkit.importer.standing import floor_shapes, points
     from simkit.model.kinematics import forward
 
     poses = forward(robot, home)
     low: dict[str, float] = {}
     for link in robot.links:
         for shape in floor_shapes(link):
-            world = _points(shape, base_dir) @ poses[link.name][:3, :3].T
+            world = points(shape, base_dir) @ poses[link.name][:3, :3].T
             z = float((world[:, 2] + poses[link.name][2, 3]).min())
             low[link.name] = min(low.get(link.name, math.inf), z)
     if not low:
@@ -106,16 +104,16 @@ def _chain(parent: dict, link: str) -> list:
     return out
 
 
-class _Support:
+class Support:
     """Where the robot touches a flat floor at a pose, and how far inside that support its
     centre of mass lies (the geometry that touches the floor, as standing.py places it)."""
 
     def __init__(self, robot, base_dir: Path):
-        from simkit.importer.standing import _points, floor_shapes
+        from simkit.importer.standing import floor_shapes, points
 
         self.robot = robot
         self.points = {
-            link.name: np.vstack([_points(shape, base_dir) for shape in floor_shapes(link)])
+            link.name: np.vstack([points(shape, base_dir) for shape in floor_shapes(link)])
             for link in robot.links
             if floor_shapes(link)
         }
@@ -170,7 +168,7 @@ def _follow(q: np.ndarray, movable, index: dict[str, int]) -> np.ndarray:
     return q
 
 
-def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
+def _resting(q, support: Support, depth, movable, limits, index) -> np.ndarray:
     """The seeded random pose nearest `q` (joint-space distance) on which the robot rests
     (CoM at least MARGIN inside its support) with no more self-contact than `q`, resting on
     its frame alone where a draw allows (Hextilt's arm servos, 0.3 N m, cannot carry it);
@@ -188,7 +186,7 @@ def _resting(q, support: _Support, depth, movable, limits, index) -> np.ndarray:
     return q
 
 
-def _better(got, best) -> bool:
+def better(got, best) -> bool:
     """A score (a number, or a tuple compared in order) higher than `best` by more than
     rounding."""
     got, best = np.atleast_1d(got), np.atleast_1d(best)
@@ -203,12 +201,10 @@ def _pair_search(q, depth, robot, model, data, adr, always, frozen, limits, inde
     first PAIR_JOINTS not frozen) two at a time over a PAIR_GRID x PAIR_GRID grid of their
     ranges: the pose with the least `depth`. iCub's shoulder clears its chest only with
     pitch and roll moved together."""
-    from simkit.importer.home import _between
-
     movable = robot.movable_joints
     best = depth(q)
-    for pair in sorted(p for p in _contacts(model, data, adr, q) if p not in always):
-        joints = [j for j in _between(robot, *pair) if j.name not in frozen][:PAIR_JOINTS]
+    for pair in sorted(p for p in contacts(model, data, adr, q) if p not in always):
+        joints = [j for j in between(robot, *pair) if j.name not in frozen][:PAIR_JOINTS]
         for a, b in itertools.combinations(joints, 2):
             ia, ib = index[a.name], index[b.name]
             grid_a = np.linspace(*limits[ia], PAIR_GRID + 2)[1:-1]
@@ -236,22 +232,17 @@ def _alike(q, depth, robot, index, movable) -> np.ndarray:
     )
 
 
-def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
+def free_home(robot, base_dir: Path, rest: bool = True) -> tuple[list[float], list[str]] | None:
     """A home pose (spec order) whose separable link pairs do not touch and on which the
     robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
-    made (`joint: a -> b`); None when home already is, or no grid pose is better."""
+    made (`joint: a -> b`); None when home already is, or no grid pose is better. `rest`
+    False: no floor (a legged robot bolted at its base): free of contact, legs kept."""
     import mujoco
-    import yaml
 
-    from simkit.model.resolve import resolve
-    from simkit.spec.schema import RobotSpec
-
-    text = spec_path.read_text(encoding="utf-8")
-    robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
     home = dict(robot.poses).get("home")
     if home is None:
         return None
-    model = mujoco.MjModel.from_xml_string(_model_xml(robot, spec_path.parent))
+    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir))
     data = mujoco.MjData(model)
     movable = robot.movable_joints
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
@@ -262,18 +253,18 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
     draws = _follow(draws, movable, index)
     always: set | None = None
     for q in draws:
-        touching = set(_contacts(model, data, adr, q))
+        touching = set(contacts(model, data, adr, q))
         always = touching if always is None else always & touching
     always = always or set()
 
     def depth(q) -> float:
         """m of penetration beyond TOUCH, summed over the separable pairs."""
-        found = _contacts(model, data, adr, q).items()
+        found = contacts(model, data, adr, q).items()
         return sum(max(d - TOUCH, 0.0) for p, d in found if p not in always)
 
     def every(q) -> float:
         """m of penetration beyond TOUCH, summed over all pairs (the always ones too)."""
-        return sum(max(d - TOUCH, 0.0) for d in _contacts(model, data, adr, q).values())
+        return sum(max(d - TOUCH, 0.0) for d in contacts(model, data, adr, q).values())
 
     def search(q, score, done, frozen):
         """Greedy: one joint at a time (distal first) to the grid value that most improves
@@ -292,15 +283,14 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
                     trial[i] = value
                     trial = _follow(trial[None, :], movable, index)[0]
                     got = score(trial)
-                    if _better(got, best):
+                    if better(got, best):
                         q, best = trial, got
         return q
 
     start = np.array(home, dtype=float)
     q = start
-    support = _Support(robot, spec_path.parent)
     if depth(q) > 0.0:
-        feet = _feet_joints(robot, home, spec_path.parent)
+        feet = _feet_joints(robot, home, base_dir)
         q = search(q, lambda t: -depth(t), lambda b: b >= 0.0, feet)
         if depth(q) > 0.0:  # two joints at once for the pairs one cannot part
             args = (robot, model, data, adr, always, feet, limits, index)
@@ -311,7 +301,8 @@ def free_home(spec_path: Path) -> tuple[list[float], list[str]] | None:
             q = start
         elif always:  # "always" here may be "nearly always" to the kit's 10000 samples
             q = search(q, lambda t: (-depth(t), -every(t)), lambda b: b[1] >= 0.0, feet)
-    if support.margin(q) < MARGIN:
+    support = Support(robot, base_dir) if rest else None
+    if support is not None and support.margin(q) < MARGIN:
         q = _resting(q, support, depth, movable, limits, index)
     changes = [
         f"{j.name}: {start[i]:.4g} -> {q[i]:.4g}"

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 
-def _points(shape, base_dir: Path) -> np.ndarray:
+def points(shape, base_dir: Path) -> np.ndarray:
     """Points bounding one primitive in its link frame (m): mesh vertices, box corners, or the
     corners of a round shape's bounding box."""
     from simkit.kitio.stl import from_stl
@@ -34,14 +34,14 @@ def _points(shape, base_dir: Path) -> np.ndarray:
     return local @ rpy_matrix(shape.rpy).T + np.asarray(shape.xyz)
 
 
-def _lowest(shape, pose: np.ndarray, base_dir: Path) -> float:
+def lowest(shape, pose: np.ndarray, base_dir: Path) -> float:
     """World z (m) of a shape's lowest point with its link at `pose`: exact for round shapes
     (a tilted shin cylinder's bounding-box corners reach below the cylinder: HyQ with its
     hips spread stood 1.7 cm above the floor), the lowest vertex or corner otherwise."""
     from simkit.model.kinematics import rpy_matrix
 
     if shape.kind not in ("sphere", "cylinder", "capsule"):
-        world = _points(shape, base_dir) @ pose[:3, :3].T + pose[:3, 3]
+        world = points(shape, base_dir) @ pose[:3, :3].T + pose[:3, 3]
         return float(world[:, 2].min())
     rotation = pose[:3, :3] @ rpy_matrix(shape.rpy)
     centre = pose[:3, :3] @ np.asarray(shape.xyz) + pose[:3, 3]
@@ -65,24 +65,17 @@ def floor_shapes(link) -> tuple:
     return link.shapes
 
 
-def standing_height(spec_path: Path) -> float | None:
+def standing_height(robot, base_dir: Path) -> float | None:
     """Height (m) of the floating base's origin that puts the robot's lowest point at home on
     the floor; None when no link has a solid."""
-    import yaml
-
     from simkit.model.kinematics import forward
-    from simkit.model.resolve import resolve
-    from simkit.spec.schema import RobotSpec
 
-    text = spec_path.read_text(encoding="utf-8")
-    spec = RobotSpec.model_validate(yaml.safe_load(text))
-    robot = resolve(spec, text.encode(), spec_path.name)
     home = dict(robot.poses).get("home")
     poses = forward(robot, home)
-    lowest = None
+    lowest_z = None
     touching = any(floor_shapes(link) for link in robot.links)
     for link in robot.links:
         for shape in floor_shapes(link) if touching else link.shapes:
-            z = _lowest(shape, poses[link.name], spec_path.parent)
-            lowest = z if lowest is None else min(lowest, z)
-    return None if lowest is None else -lowest
+            z = lowest(shape, poses[link.name], base_dir)
+            lowest_z = z if lowest_z is None else min(lowest_z, z)
+    return None if lowest_z is None else -lowest_z

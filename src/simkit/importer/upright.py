@@ -14,7 +14,6 @@ down, not a flat drone), the base is turned so that direction points down. Repor
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
@@ -69,17 +68,11 @@ def limb_ends(robot, poses: dict, base: str) -> np.ndarray:
     return total
 
 
-def upright(spec_path: Path) -> tuple[tuple[float, float, float], str] | None:
+def upright(robot) -> tuple[tuple[float, float, float], str] | None:
     """The floating joint's rpy (rad) that stands the robot on its limbs, and why; None where
     the identity does (the limbs hang along -z, or nothing tells)."""
-    import yaml
-
     from simkit.model.kinematics import forward
-    from simkit.model.resolve import resolve
-    from simkit.spec.schema import RobotSpec
 
-    text = spec_path.read_text(encoding="utf-8")
-    robot = resolve(RobotSpec.model_validate(yaml.safe_load(text)), text.encode(), spec_path.name)
     floating = robot.floating_joint
     if floating is None:
         return None

@@ -48,8 +48,68 @@ def spec_yaml(spec: dict, lines: list[str], source: Path) -> str:
     return "\n".join(head) + "\n" + body
 
 
-def check(path: Path) -> None:
-    """Load the written spec through simkit's own validation (SpecError on a problem)."""
-    from simkit.spec.validate import load_spec
+def check(path: Path, draft) -> None:
+    """Load the written spec through simkit's own validation; a problem is one line at the
+    URDF element its field comes from (importer/located.py), never the staging copy."""
+    from simkit.importer import located
 
-    load_spec(path, display=str(path))
+    located.check(path, draft.spec, draft.source, draft.renames)
+
+
+def finish(draft, out_dir: Path) -> Path:
+    """Write the draft's spec once, validate it once (`check`), and copy it with its meshes
+    from the staging folder into `out_dir`; a mesh the spec written there before used and
+    this one does not is removed (no stale meshes). Returns the spec's path in `out_dir`."""
+    from simkit.importer import provenance
+    from simkit.importer.output import publish
+
+    provenance.keep(draft)
+    name = draft.spec["name"]
+    staged = draft.stage / f"{name}.yaml"
+    staged.write_text(spec_yaml(draft.spec, draft.report.lines, draft.path), encoding="utf-8")
+    check(staged, draft)
+    target = out_dir / f"{name}.yaml"
+    new = {item.relative_to(draft.stage) for item in draft.stage.rglob("*") if item.is_file()}
+    others = set().union(*(_meshes_of(p) for p in out_dir.glob("*.yaml") if p != target))
+    for old in sorted(_meshes_of(target) - new - others):  # another spec's stay
+        (out_dir / old).unlink(missing_ok=True)
+    publish(draft.stage, out_dir)  # each file whole (output.py), or one line naming it
+    return target
+
+
+def _meshes_of(spec_path: Path) -> set[Path]:
+    """The relative mesh files an earlier spec at `spec_path` names (none if unreadable)."""
+    try:
+        spec = yaml.safe_load(spec_path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError, UnicodeDecodeError):
+        return set()
+    out: set[Path] = set()
+    links = spec.get("links") if isinstance(spec, dict) else None
+    for link in links if isinstance(links, list) else []:
+        for key in ("solid", "collision_shapes", "collision_primitives"):
+            shapes = link.get(key) if isinstance(link, dict) else None
+            for shape in shapes if isinstance(shapes, list) else []:
+                if isinstance(shape, dict) and isinstance(shape.get("file"), str):
+                    rel = Path(shape["file"])
+                    if not rel.is_absolute() and ".." not in rel.parts:
+                        out.add(rel)
+    return out
+
+
+def canonical_faces(vertices, faces):
+    """The same closed mesh with its triangles in one order whatever order a repair left
+    them in (trimesh's winding fix visits faces in varying order): each triangle starts at
+    its lexicographically smallest corner (winding kept), triangles sorted by their corners'
+    coordinates. Byte-identical STL files for the same input mesh."""
+    import numpy as np
+
+    faces = np.asarray(faces)
+    corners = np.asarray(vertices, dtype=float)[faces]  # (n, 3, 3)
+    flat = corners.reshape(-1, 3)
+    rank = np.empty(len(flat), dtype=np.int64)
+    rank[np.lexsort(flat.T[::-1])] = np.arange(len(flat))
+    first = rank.reshape(-1, 3).argmin(axis=1)
+    turn = (np.arange(3)[None, :] + first[:, None]) % 3
+    rows = np.arange(len(faces))[:, None]
+    ordered = corners[rows, turn].reshape(len(faces), 9)
+    return vertices, faces[rows, turn][np.lexsort(ordered.T[::-1])]

@@ -198,6 +198,7 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
                 f.rpy_rad(),
                 tuple(f.estimated),  # type: ignore[arg-type]
                 f.site_size,
+                f.joint,
             )
             for f in spec.frames
         ),

@@ -170,6 +170,12 @@ class Frame:
     rpy: Vec3
     estimated: tuple[str, ...] = ()
     site_size: float | None = None
+    joint: str | None = None  # the URDF fixed joint's name; None: NAME_joint
+
+    @property
+    def joint_name(self) -> str:
+        """The name of the fixed joint that holds the frame in the kit's URDF."""
+        return self.joint or f"{self.name}_joint"
 
 
 @dataclass(frozen=True)

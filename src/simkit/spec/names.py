@@ -22,6 +22,9 @@ MAX_NAME = 64
 MAX_ROBOT_NAME = 48
 NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 ROBOT_NAME = re.compile(r"[a-z][a-z0-9_]*")
+#: A frame's `joint` appears in the kit's URDF alone (an XML attribute): URDF names such as
+#: `wrist_3_link-tool0_fixed_joint` are kept as they are.
+URDF_ONLY_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*")
 
 #: Names some emitter writes itself (SRDF virtual joint, ros2_control broadcaster, MJCF world).
 RESERVED = frozenset({"world", "virtual_joint", "joint_state_broadcaster"})
@@ -41,9 +44,11 @@ GENERATED_SUFFIXES = {
 }
 
 
-def name_problem(value: object, robot: bool = False) -> str | None:
-    """Why `value` is not a valid name, or None."""
+def name_problem(value: object, robot: bool = False, urdf_only: bool = False) -> str | None:
+    """Why `value` is not a valid name, or None (`urdf_only`: a name only the kit's URDF
+    writes, which may also hold `.` and `-`)."""
     grammar, cap = (ROBOT_NAME, MAX_ROBOT_NAME) if robot else (NAME, MAX_NAME)
+    grammar = URDF_ONLY_NAME if urdf_only and not robot else grammar
     if not isinstance(value, str):
         return f"a name must be a string, got {type(value).__name__}"
     if not value:
@@ -52,6 +57,7 @@ def name_problem(value: object, robot: bool = False) -> str | None:
         return f"a name has at most {cap} characters (this one has {len(value)})"
     if not grammar.fullmatch(value):
         allowed = "a-z, 0-9 and _ (starting with a letter)" if robot else "A-Z, a-z, 0-9 and _"
+        allowed += ", . and -" if urdf_only else ""
         shown = value if value.isprintable() else repr(value)
         return f"invalid name '{shown}': use only {allowed}, not starting with a digit"
     return None
@@ -63,6 +69,9 @@ def _named(spec) -> Iterator[tuple[str, Loc, str]]:
     for kind in ("links", "joints", "frames", "materials", "planning_groups"):
         for i, item in enumerate(getattr(spec, kind)):
             yield kind, (kind, i, "name"), item.name
+    for i, frame in enumerate(spec.frames):  # a frame's own URDF joint name
+        if getattr(frame, "joint", None) is not None:
+            yield "frame_joint", ("frames", i, "joint"), frame.joint
     for key in ("poses", "poses_deg"):
         for pose in getattr(spec, key):
             yield "poses", (key, pose), pose
@@ -85,6 +94,8 @@ def _generated(spec) -> dict[str, str]:
     out: dict[str, str] = {}
     for kind, suffixes in GENERATED_SUFFIXES.items():
         for item in getattr(spec, kind):
+            if getattr(item, "joint", None) is not None:  # a frame naming its own joint
+                continue
             for suffix in suffixes:
                 if "#" not in suffix:
                     out[(item.name + suffix).lower()] = f"{kind[:-1]} '{item.name}'"
@@ -105,8 +116,8 @@ def problems(spec) -> Iterator[Problem]:
         yield ("name",), why
     named = list(_named(spec))
     bad = False
-    for _kind, loc, value in named:
-        why = name_problem(value)
+    for kind, loc, value in named:
+        why = name_problem(value, urdf_only=kind == "frame_joint")
         if why:
             bad = True
             yield loc, why
@@ -119,10 +130,10 @@ def problems(spec) -> Iterator[Problem]:
         if kind == "ref":
             continue
         low = value.lower()
-        if low in RESERVED and kind in ("links", "joints", "frames"):
+        if low in RESERVED and kind in ("links", "joints", "frames", "frame_joint"):
             yield loc, f"'{value}' is a name simkit writes itself; choose another"
             continue
-        if kind in ("links", "joints", "frames", "root"):
+        if kind in ("links", "joints", "frames", "root", "frame_joint"):
             if low in generated:
                 yield loc, f"'{value}' is the name simkit generates for {generated[low]}"
                 continue
@@ -130,7 +141,7 @@ def problems(spec) -> Iterator[Problem]:
             if owner is not None:
                 yield loc, f"'{value}' is the name simkit generates for a piece of link '{owner}'"
                 continue
-        space = "tree" if kind in ("links", "joints", "frames", "root") else kind
+        space = "tree" if kind in ("links", "joints", "frames", "root", "frame_joint") else kind
         seen = firsts.setdefault((space, low), (value, loc))
         if seen[0] != value:
             yield loc, f"'{value}' differs from '{seen[0]}' only by case; names must differ"

@@ -271,6 +271,9 @@ class FrameSpec(Placed):
     parent: str
     site_size: PositiveFloat | None = None  # m, radius of the MJCF site (default 0.005)
     estimated: tuple[str, ...] = ()
+    #: the fixed joint holding it in the kit's URDF (default NAME_joint): an imported URDF's
+    #: own joint name, kept so that anything keyed on joint names still finds it
+    joint: str | None = None
 
 
 class MaterialSpec(Strict):

@@ -183,7 +183,7 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
     yield from spec_urdf_blocks.problems(
         spec,
         {spec.root, *links, *frames},
-        {j.name for j in spec.joints} | {f"{name}_joint" for name in frames},
+        {j.name for j in spec.joints} | {f.joint or f"{f.name}_joint" for f in spec.frames},
     )
 
     movable = [j for j in spec.joints if j.type not in ("fixed", "floating")]

@@ -1,0 +1,176 @@
+"""The fix-ups an import applies to its draft after translating the URDF, in order.
+
+Each step reads the draft's resolved robot, changes the draft only where it must (the URDF's
+zero pose is kept unless links collide, a servo cannot hold it, or a floating base needs a
+place to stand), and gives each change one report line with its reason:
+
+0. `rotors`: each driven joint's estimated rotor inertia (armature), bounded by what the
+   joint moves (masses.py).
+1. `base`: a floating robot drawn Y-up is turned to stand on its limbs (upright.py).
+2. `home`: out of self-contact: any joint between touching links may move for a fixed base
+   (home.py), then to where the servos hold it against gravity (gravity.py); a floating
+   robot keeps its feet and comes to rest on the floor (stance.py).
+3. `stand`: the floating base placed on the floor (standing.py), or where it comes to rest
+   leaning on its frame (settle.py); a legged robot bolted at its root is raised so that its
+   feet reach the floor.
+4. `limits`: estimated position limits narrowed to the range free of self-contact
+   (limits.py).
+"""
+
+from __future__ import annotations
+
+from simkit.importer.draft import Draft
+
+
+def base(draft: Draft) -> None:
+    """A Y-up floating robot lies on its side at the identity: turn its base."""
+    from simkit.importer import upright
+
+    if not draft.floating:
+        return
+    turned = upright.upright(draft.robot())
+    if turned is not None:
+        draft.estimate_base(("rpy",), rpy=[float(f"{v:.6g}") for v in turned[0]])
+        draft.report.assumed(draft.source, draft.source.root, turned[1])
+
+
+def home(draft: Draft) -> None:
+    """`home` out of self-contact; for a fixed base, also held against gravity."""
+    from simkit.importer import gravity, stance
+    from simkit.importer import home as free
+
+    if draft.floating:  # stance.py: out of self-contact with the feet kept
+        why = (
+            "at the first guess (0, or mid-range outside the limits) links collide or the "
+            "robot cannot rest on the floor"
+        )
+        draft.set_home(stance.free_home(draft.robot(), draft.stage), why)
+        return
+    why = "the links collide at the first guess (0, or mid-range outside the limits)"
+    if draft.legged:  # bolted at the pelvis: the legs hang as they are, the arms move
+        found = _bolted_home(draft) if free.in_contact(draft.robot(), draft.stage) else None
+    else:
+        found = free.free_home(draft.robot(), draft.stage)
+        if found is None and free.in_contact(draft.robot(), draft.stage):
+            found = _bolted_home(draft)
+    draft.set_home(found, why)
+    held = gravity.held_home(draft.robot(), draft.stage)
+    if held is not None:
+        draft.set_home(held[:2], held[2])
+
+
+def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:
+    """Where one joint at a time cannot part the links (a humanoid bolted at the pelvis, its
+    hands inside its thighs): the stance search with the legs kept as they hang (stance.py),
+    then home.py's clearance search from there; the changes from the first guess."""
+    from simkit.importer import home as free
+    from simkit.importer import stance
+
+    found = stance.free_home(draft.robot(), draft.stage, rest=False)
+    if found is None:
+        return None
+    first = list(draft.spec["poses"]["home"])
+    draft.spec["poses"]["home"] = found[0]
+    draft.changed()
+    pose = found[0]
+    for every in (False, True):  # then pairs the search took for always touching (the kit
+        polished = free.free_home(draft.robot(), draft.stage, every)  # samples more)
+        if polished is not None:
+            pose = draft.spec["poses"]["home"] = polished[0]
+            draft.changed()
+    draft.spec["poses"]["home"] = first
+    draft.changed()
+    names = [j["name"] for j in draft.movable()]
+    moved = zip(names, first, pose, strict=True)
+    changes = [f"{n}: {a:.4g} -> {b:.4g}" for n, a, b in moved if a != b]
+    return (pose, changes) if changes else None
+
+
+def stand(draft: Draft) -> None:
+    """Raise a floating base so that the robot stands on the floor at home, then start it
+    where it comes to rest when it tips onto its frame (a flying arm)."""
+    from simkit.importer import standing
+
+    if not draft.floating and not draft.legged:
+        return
+    height = standing.standing_height(draft.robot(), draft.stage)
+    if height is None:
+        return
+    if not draft.floating:  # bolted at the pelvis: raised so that its feet reach the floor
+        if height > 0.0:
+            draft.estimate_base(("xyz",), xyz=[0.0, 0.0, float(f"{height:.6f}")])
+            draft.report.changed(
+                draft.source,
+                draft.source.root,
+                f"fixed base bolted {height:.6f} m up: the legs' lowest point at home on the "
+                "floor, as the robot stands",
+            )
+        return
+    draft.estimate_base(("xyz",), xyz=[0.0, 0.0, float(f"{height:.6f}")])
+    draft.report.changed(
+        draft.source,
+        draft.source.root,
+        f"floating base placed {height:.6f} m up: its lowest point at home on the floor",
+    )
+    _settle(draft)
+
+
+def _settle(draft: Draft) -> None:
+    """The free joint where the robot comes to rest at home when that is tilted onto its
+    frame (settle.py), and the home its servos hold that rest with."""
+    from simkit.importer import settle
+
+    found = settle.rest_pose(draft.robot(), draft.stage)
+    if found is None:
+        return
+    pose, rest, why = found
+    spec = draft.spec
+    if pose != spec["poses"]["home"]:
+        moved = ", ".join(
+            f"{j['name']}: {a:.4g} -> {b:.4g}"
+            for j, a, b in zip(draft.movable(), spec["poses"]["home"], pose, strict=True)
+            if a != b
+        )
+        why = f"home: the rest with the least servo load; {moved} rad or m; " + why
+        spec["poses"]["home"] = pose
+    draft.estimate_base(
+        ("xyz", "rpy"),
+        xyz=[round(v, 4) + 0.0 for v in rest.xyz],
+        rpy=[round(v, 4) + 0.0 for v in rest.rpy],
+    )
+    draft.report.assumed(draft.source, draft.source.root, why)
+
+
+def limits(draft: Draft) -> None:
+    """Estimated position limits narrowed to the joint's range free of self-contact from
+    home (limits.py), one report line per joint."""
+    from simkit.importer import limits as free
+
+    found = free.narrowed(draft.robot(), draft.stage)
+    if not found:
+        return
+    source = draft.source
+    for joint in draft.spec["joints"]:
+        if joint["name"] in found:
+            old = (joint["lower"], joint["upper"])
+            joint["lower"], joint["upper"] = found[joint["name"]]
+            element = source.root.find(f"joint[@name='{joint['name']}']")
+            draft.report.assumed(
+                source,
+                source.root if element is None else element,
+                f"estimated limits {old[0]:.4g} .. {old[1]:.4g} narrowed to "
+                f"{joint['lower']:.4g} .. {joint['upper']:.4g}, the range the joint turns "
+                "from home without self-contact",
+            )
+    draft.changed()
+
+
+def rotors(draft: Draft) -> None:
+    """Estimated armature per driven joint (masses.armature)."""
+    from simkit.importer.masses import armature
+
+    armature(draft)
+
+
+#: the fix-ups, in the order they run
+STEPS = (rotors, base, home, stand, limits)
