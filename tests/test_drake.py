@@ -21,12 +21,9 @@ pytest.importorskip("pydrake", reason="drake is not installed (pip install -e .[
 mujoco = pytest.importorskip("mujoco")
 
 from pydrake.geometry import Role  # noqa: E402
-from pydrake.multibody.parsing import Parser  # noqa: E402
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph  # noqa: E402
-from pydrake.systems.framework import DiagramBuilder  # noqa: E402
 
+from drake_load import load_kit  # noqa: E402
 from mjcompat import full_mass_matrix  # noqa: E402
-from simkit.check.readers.tree import read_urdf  # noqa: E402
 
 pytestmark = pytest.mark.slow
 
@@ -37,22 +34,8 @@ FK_TOL = 1e-9  # m, and rotation-matrix entries
 
 
 def _drake(kit: Path, fmt: str):
-    """(plant, context, scene graph inspector) of the kit's URDF or SDF. A fixed-base URDF's
-    root link is welded to the world (SDF welds it itself; a URDF root named `world` is
-    Drake's world)."""
-    doc = json.loads((kit / "robot.json").read_text())
-    path = kit / fmt / f"{doc['name']}.{fmt}"
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    (instance,) = Parser(plant).AddModels(str(path))
-    if fmt == "urdf" and not doc.get("floating_base"):
-        root = read_urdf(path).root
-        if root != "world":
-            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root, instance))
-    plant.Finalize()
-    diagram = builder.Build()
-    context = plant.GetMyContextFromRoot(diagram.CreateDefaultContext())
-    return plant, instance, context, scene_graph.model_inspector(), path
+    """The kit in Drake (tests/drake_load.py)."""
+    return load_kit(kit, fmt)
 
 
 def _random_qpos(model, rng: np.random.Generator) -> np.ndarray:

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from simkit.check.readers.tree import read_urdf
+from drake_load import load_kit
 from simkit.importer import import_robot
 from simkit.kitio.cache import Cache
 from simkit.kitio.obj import from_obj
@@ -39,21 +39,8 @@ def _proximity_geometries(kit: Path, fmt: str) -> tuple[int, int]:
     """(SceneGraph proximity geometries, `<collision>` elements) of the kit's URDF or SDF,
     loaded into a MultibodyPlant with SceneGraph (the fixed URDF root welded to the world)."""
     from pydrake.geometry import Role
-    from pydrake.multibody.parsing import Parser
-    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-    from pydrake.systems.framework import DiagramBuilder
 
-    doc = json.loads((kit / "robot.json").read_text())
-    path = kit / fmt / f"{doc['name']}.{fmt}"
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    (instance,) = Parser(plant).AddModels(str(path))
-    if fmt == "urdf" and not doc.get("floating_base"):
-        root = read_urdf(path).root
-        if root != "world":
-            plant.WeldFrames(plant.world_frame(), plant.GetFrameByName(root, instance))
-    plant.Finalize()
-    inspector = scene_graph.model_inspector()
+    _plant, _instance, _context, inspector, path = load_kit(kit, fmt)
     return inspector.NumGeometriesWithRole(Role.kProximity), path.read_text().count("<collision ")
 
 
