@@ -129,7 +129,8 @@ def axis_inertias(robot, q) -> dict[str, float]:
         sums[link.name] = part
     for joint in reversed(robot.joints):  # joints list parents first: children summed first
         if joint.parent in sums and joint.child in sums:
-            sums[joint.parent] = [a + b for a, b in zip(sums[joint.parent], sums[joint.child])]
+            both = zip(sums[joint.parent], sums[joint.child], strict=True)
+            sums[joint.parent] = [a + b for a, b in both]
     out = {}
     for joint in robot.movable_joints:
         mass, first, second, spin = sums[joint.child]
