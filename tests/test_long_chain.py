@@ -43,17 +43,19 @@ def _urdf(path: Path, parents: list[int], kinds: tuple[str, ...] = ("revolute",)
 
 
 @pytest.mark.slow
-def test_a_chain_of_2000_links_imports_and_validates(tmp_path):
+@pytest.mark.parametrize("base", ["--fixed-base", "--floating-base"])
+def test_a_chain_of_2000_links_imports_and_validates(tmp_path, base):
     """Refused at 256 links before; with that cap raised, a RecursionError in serialising
-    the MuJoCo model. The MuJoCo searches are skipped above SEARCH_LINKS, one line each."""
+    the MuJoCo model (fixed) or in upright.py's limb walk (floating). The MuJoCo searches are
+    skipped above SEARCH_LINKS, one line each."""
     urdf = _urdf(tmp_path / "chain.urdf", list(range(1999)))
     out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "simkit.cli", "import", str(urdf), "--out", str(out)]
+    cmd = [sys.executable, "-m", "simkit.cli", "import", str(urdf), "--out", str(out), base]
     run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)  # a hang guard
     assert run.returncode == 0, run.stderr
     assert "Traceback" not in run.stderr
     spec, _doc = load_spec(out / "chain.yaml")
-    assert len(spec.links) == 2000 and len(spec.joints) == 2000  # and the bolt to the world
+    assert len(spec.links) == 2000 and len(spec.joints) == 2000  # and the base's joint
     skipped = [
         line for line in run.stdout.splitlines() + run.stderr.splitlines() if "skipped" in line
     ]
