@@ -1,7 +1,8 @@
 """Time `simkit import` on chains of N links (issue 24: near-linear, no RecursionError).
 
 Usage: python scripts/time_long_chain.py [N ...]   (default 500 2000 10000)
-Prints N, seconds and the outcome (the spec's link cap refuses long chains in one line).
+Prints N, seconds and the outcome: imported, or refused in one line (a spec holds at most
+10,000 links, spec/bounds.py MAX_BODIES). Figures: docs/performance.md.
 """
 
 from __future__ import annotations

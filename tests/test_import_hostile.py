@@ -58,14 +58,15 @@ def test_a_root_link_named_world_with_geometry_imports(tmp_path):
     assert spec["root"] == "world_frame"
 
 
-def test_a_chain_longer_than_the_recursion_limit_is_refused_in_one_line(tmp_path):
-    """1,200 links (Python's recursion limit is 1,000): a one-line refusal naming the spec's
-    limit, not a RecursionError. Time is measured by scripts/time_long_chain.py."""
+def test_a_chain_longer_than_the_spec_limit_is_refused_in_one_line(tmp_path):
+    """10,001 links, one more than a spec holds (spec/bounds.py MAX_BODIES): a one-line
+    refusal naming the limit, before any per-link work. Chains up to the limit import
+    (tests/test_long_chain.py; times: scripts/time_long_chain.py, docs/performance.md)."""
     body = [_link("l0")]
-    for k in range(1, 1200):
+    for k in range(1, 10001):
         body += [_link(f"l{k}"), _joint(f"j{k}", f"l{k - 1}", f"l{k}", 0.01)]
     with pytest.raises(
-        SpecError, match=r"r\.urdf:2: robot\[r\]: 1200 links: a spec holds at most 256"
+        SpecError, match=r"r\.urdf:2: robot\[r\]: 10001 links: a spec holds at most 10000"
     ):
         import_robot(_write(tmp_path, *body), tmp_path / "out")
     _no_staging(tmp_path / "out")

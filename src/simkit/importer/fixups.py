@@ -21,6 +21,27 @@ from __future__ import annotations
 
 from simkit.importer.draft import Draft
 
+#: links above which the fix-ups that compile a MuJoCo model of the robot (home's contact
+#: and gravity searches, the floating rest, limits narrowing) are skipped, one report line
+#: each: MuJoCo's XML reader refuses bodies nested about 500 deep, its compiler a tree deeper
+#: than 1024, and its compile time grows with the square of the depth (docs/performance.md)
+SEARCH_LINKS = 400
+
+
+def searched(draft: Draft, what: str) -> bool:
+    """Whether the robot is small enough for the MuJoCo searches (`SEARCH_LINKS`); if not,
+    report that `what` is skipped."""
+    links = len(draft.spec["links"])
+    if links <= SEARCH_LINKS:
+        return True
+    draft.report.assumed(
+        draft.source,
+        draft.source.root,
+        f"{what} skipped: {links} links, more than the {SEARCH_LINKS} the MuJoCo searches "
+        "take (importer/fixups.py SEARCH_LINKS)",
+    )
+    return False
+
 
 def base(draft: Draft) -> None:
     """A Y-up floating robot lies on its side at the identity: turn its base."""
@@ -39,6 +60,8 @@ def home(draft: Draft) -> None:
     from simkit.importer import gravity, stance
     from simkit.importer import home as free
 
+    if not searched(draft, "home out of self-contact and held against gravity"):
+        return
     if draft.floating:  # stance.py: out of self-contact with the feet kept
         why = (
             "at the first guess (0, or mid-range outside the limits) links collide or the "
@@ -120,6 +143,8 @@ def _settle(draft: Draft) -> None:
     frame (settle.py), and the home its servos hold that rest with."""
     from simkit.importer import settle
 
+    if not searched(draft, "the rest on the frame"):
+        return
     found = settle.rest_pose(draft.robot(), draft.stage)
     if found is None:
         return
@@ -146,6 +171,8 @@ def limits(draft: Draft) -> None:
     home (limits.py), one report line per joint."""
     from simkit.importer import limits as free
 
+    if not searched(draft, "estimated limits narrowed to the range free of self-contact"):
+        return
     found = free.narrowed(draft.robot(), draft.stage)
     if not found:
         return

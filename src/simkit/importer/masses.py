@@ -111,16 +111,38 @@ def solid_mass(shapes: list[dict], stage: Path, density: float):
     return mass, com, tensor, volume, whats
 
 
-def _axis_inertia(robot, joint, q) -> float:
-    """kg m^2 about a revolute joint's axis (kg for a prismatic one) of what it moves at `q`."""
-    from simkit.model.dynamics import axis_inertia, subtree_links
+def axis_inertias(robot, q) -> dict[str, float]:
+    """Per movable joint: kg m^2 about a revolute joint's axis (kg for a prismatic one) of
+    everything it moves at `q` (dynamics.axis_inertia's measure). Each link's mass, first and
+    second moments (world frame, at the origin) are summed up the tree once, children before
+    parents, and shifted to each joint's axis: linear in the links, not quadratic."""
+    from simkit.model.kinematics import forward
 
-    if joint.type == "prismatic":
-        moved = set(subtree_links(robot, joint.name))
-        return sum(
-            link.inertial.mass for link in robot.links if link.name in moved and link.inertial
-        )
-    return axis_inertia(robot, joint.name, q)
+    poses = forward(robot, q)
+    sums: dict[str, list] = {}  # link -> [mass, sum m p, sum m p p^T, sum R I R^T]
+    for link in robot.links:
+        part = [0.0, np.zeros(3), np.zeros((3, 3)), np.zeros((3, 3))]
+        if link.inertial is not None and link.name in poses:
+            rot, mass = poses[link.name][:3, :3], link.inertial.mass
+            p = rot @ np.asarray(link.inertial.com) + poses[link.name][:3, 3]
+            part = [mass, mass * p, mass * np.outer(p, p), rot @ link.inertial.tensor() @ rot.T]
+        sums[link.name] = part
+    for joint in reversed(robot.joints):  # joints list parents first: children summed first
+        if joint.parent in sums and joint.child in sums:
+            both = zip(sums[joint.parent], sums[joint.child], strict=True)
+            sums[joint.parent] = [a + b for a, b in both]
+    out = {}
+    for joint in robot.movable_joints:
+        mass, first, second, spin = sums[joint.child]
+        if joint.type == "prismatic":
+            out[joint.name] = float(mass)
+            continue
+        axis = poses[joint.child][:3, :3] @ np.asarray(joint.axis)
+        o = poses[joint.child][:3, 3]
+        r2 = np.trace(second) - 2 * o @ first + mass * (o @ o)  # sum m |p - o|^2
+        along = axis @ second @ axis - 2 * (axis @ o) * (axis @ first) + mass * (axis @ o) ** 2
+        out[joint.name] = float(axis @ spin @ axis + r2 - along)
+    return out
 
 
 def armature(draft) -> None:
@@ -129,14 +151,18 @@ def armature(draft) -> None:
     robot = draft.robot()
     home = dict(robot.poses).get("home")
     source = draft.source
+    inertias = axis_inertias(robot, home)
+    named: dict = {}  # the first URDF joint of each name, as `find` gives it
+    for element in source.root.findall("joint"):
+        named.setdefault(element.get("name"), element)
     for spec in draft.movable():
         if "mimic" in spec or "armature" in spec:
             continue  # a follower has no servo of its own
         effort = float(spec["effort_peak"])
-        own = _axis_inertia(robot, robot.joint(spec["name"]), home)
+        own = inertias[spec["name"]]
         by_effort = float(f"{ARMATURE_PER_EFFORT * effort:.3g}")
         bound = float(f"{ARMATURE_SHARE * own:.3g}")
-        element = source.root.find(f"joint[@name='{spec['name']}']")
+        element = named.get(spec["name"])
         limit = None if element is None else element.find("limit")
         where = limit if limit is not None else element if element is not None else source.root
         unit = "kg" if spec["type"] == "prismatic" else "kg m^2"

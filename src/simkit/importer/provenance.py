@@ -84,18 +84,22 @@ def differences(
             add(f"{key}.{old}.name", f"renamed: '{old}' is not a name the kit can hold", new)
     _added(spec, source, back, add)
     _frames(spec, source, back, add)
-    _reshaped(spec, source, report, back, add)
+    lines = Said(report)
+    _reshaped(spec, source, lines, back, add)
     for kind, fields in COMPARED.items():
         tag = kind[:-1]
+        named: dict = {}  # the first element of each name, as `find` gives it
+        for element in source.root.findall(tag):
+            named.setdefault(element.get("name"), element)
         for item in spec.get(kind, []):
             old = back.get(item["name"], item["name"])
-            element = source.root.find(f"{tag}[@name='{_quoted(old)}']")
-            said = _said(report, source, element)
+            element = named.get(_quoted(old))
+            said = _said(lines, source, element)
             for field in item.get("estimated", []):
                 if field in fields:
                     add(f"{kind}.{old}.{field}", said or GENERIC[field])
             if kind == "links" and element is not None:
-                _dropped(report, source, element, f"links.{old}", add)
+                _dropped(lines, source, element, f"links.{old}", add)
             if kind == "links" and item.get("inertia_decision"):
                 add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
             if kind == "joints" and element is not None and element.get("type") != item["type"]:
@@ -118,7 +122,7 @@ def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
 RESHAPED = ("parent", "origin", "axis", "lower", "upper", "max_velocity", "effort_peak")
 
 
-def _reshaped(spec: dict, source: Source, report: Report, back: dict[str, str], add) -> None:
+def _reshaped(spec: dict, source: Source, report: Said, back: dict[str, str], add) -> None:
     """A URDF joint of a type the kit has no equivalent for (PyBullet's `spherical`) becomes
     several kit joints through links the URDF lacks: the URDF joint's compared fields, and
     each kit link or joint the URDF lacks, are listed with the import's report line."""
@@ -153,7 +157,7 @@ def _frames(spec: dict, source: Source, back: dict[str, str], add) -> None:
                     add(f"joints.{joint.get('name')}.name", reason, kit)
 
 
-def _dropped(report: Report, source: Source, link, key: str, add) -> None:
+def _dropped(report: Said, source: Source, link, key: str, add) -> None:
     """A visual or collision element the import left out (unreadable mesh, a primitive below
     a millimetre, ...): listed for the record (the check compares no geometry)."""
     for tag in ("visual", "collision"):
@@ -167,15 +171,30 @@ def _dropped(report: Report, source: Source, link, key: str, add) -> None:
             add(f"{key}.{tag}", "left out: " + "; ".join(said[:4]))
 
 
-def _said(report: Report, source: Source, element) -> str:
+class Said:
+    """The report's lines, indexed by each `FILE:LINE: ELEMENT: ` prefix they may start
+    with, so that finding an element's lines takes time in its lines, not in the report's
+    (a chain of thousands of links has thousands of each)."""
+
+    def __init__(self, report: Report) -> None:
+        self.lines = tuple(report.lines)
+        self.index: dict[str, list[int]] = {}
+        for i, line in enumerate(self.lines):
+            at = line.find(": ")
+            while at >= 0:
+                self.index.setdefault(line[: at + 2], []).append(i)
+                at = line.find(": ", at + 1)
+
+
+def _said(report: Said, source: Source, element) -> str:
     """The report's messages about `element` or an element inside it (each report line
-    starts `FILE:LINE: ELEMENT: `, so a URDF on one line still tells a link from a joint)."""
+    starts `FILE:LINE: ELEMENT: `, so a URDF on one line still tells a link from a joint),
+    in report order."""
     if element is None:
         return ""
-    prefixes = tuple(
-        sorted({f"{source.path.name}:{line_of(e)}: {describe(e)}: " for e in element.iter()})
-    )
-    said = [line[len(p) :] for line in report.lines for p in prefixes if line.startswith(p)]
+    prefixes = {f"{source.path.name}:{line_of(e)}: {describe(e)}: " for e in element.iter()}
+    hits = sorted((i, p) for p in prefixes for i in report.index.get(p, ()))
+    said = [report.lines[i][len(p) :] for i, p in hits]
     return "; ".join(said[:4])
 
 

@@ -47,23 +47,31 @@ def limb_ends(robot, poses: dict, base: str) -> np.ndarray:
     for joint in robot.joints:
         kids.setdefault(joint.parent, []).append(joint)
 
-    def ends(link: str) -> list[str]:
-        out = []
+    ends: dict[str, list[str]] = {}  # per link below the base, children first (no recursion:
+    stack = [(base, False)]  # a chain of thousands of links)
+    while stack:
+        link, done = stack.pop()
+        if not done:
+            stack.append((link, True))
+            stack.extend((joint.child, False) for joint in kids.get(link, []))
+            continue
+        out: list[str] = []
         for joint in kids.get(link, []):
-            below = ends(joint.child)
-            out += below or ([joint.child] if joint.movable else [])
-        return out
+            out += ends[joint.child] or ([joint.child] if joint.movable else [])
+        ends[link] = out
 
-    def firsts(link: str) -> list:
-        out = []
-        for joint in kids.get(link, []):
-            out += [joint] if joint.movable else firsts(joint.child)
-        return out
+    firsts, pending = [], list(reversed(kids.get(base, [])))  # depth first, in joint order
+    while pending:
+        joint = pending.pop()
+        if joint.movable:
+            firsts.append(joint)
+        else:
+            pending.extend(reversed(kids.get(joint.child, [])))
 
     at = points(robot, poses, base)
     total = np.zeros(3)
-    for joint in firsts(base):
-        names = ends(joint.child) or [joint.child]
+    for joint in firsts:
+        names = ends[joint.child] or [joint.child]
         total += max((at[n] for n in names), key=lambda p: float(np.linalg.norm(p)))
     return total
 

@@ -19,12 +19,16 @@ SERVO_ERROR_RAD = 0.01
 def subtree_links(robot: Robot, joint_name: str) -> list[str]:
     """Names of every link moved by a joint (its child and all descendants)."""
     start = robot.joint(joint_name).child
+    children: dict[str, list[str]] = {}
+    for j in robot.joints:
+        children.setdefault(j.parent, []).append(j.child)
     out, stack = [], [start]
     while stack:
         node = stack.pop()
         out.append(node)
-        stack.extend(j.child for j in robot.joints if j.parent == node)
-    return sorted(out, key=[lnk.name for lnk in robot.links].index)
+        stack.extend(children.get(node, ()))
+    order = {name: i for i, name in reversed(list(enumerate(lnk.name for lnk in robot.links)))}
+    return sorted(out, key=order.__getitem__)
 
 
 def axis_inertia(robot: Robot, joint_name: str, q=None, extra=()) -> float:

@@ -7,6 +7,7 @@ Transforms follow `T_a_b` = pose of frame b in frame a.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -289,17 +290,23 @@ class Robot:
     #: the kit's intended differences from that source: (what, reason, kit name or None)
     source_differences: tuple[tuple[str, str, str | None], ...] = ()
 
-    def link(self, name: str) -> Link:
+    @cached_property
+    def by_name(self) -> tuple[dict[str, Link], dict[str, Joint]]:
+        """Links and joints by name (the first of a name): lookups in constant time, so that
+        a walk over a chain of thousands of links stays linear."""
+        links: dict[str, Link] = {}
+        joints: dict[str, Joint] = {}
         for link in self.links:
-            if link.name == name:
-                return link
-        raise KeyError(name)
+            links.setdefault(link.name, link)
+        for joint in self.joints:
+            joints.setdefault(joint.name, joint)
+        return links, joints
+
+    def link(self, name: str) -> Link:
+        return self.by_name[0][name]
 
     def joint(self, name: str) -> Joint:
-        for joint in self.joints:
-            if joint.name == name:
-                return joint
-        raise KeyError(name)
+        return self.by_name[1][name]
 
     @property
     def floating_joint(self) -> Joint | None:

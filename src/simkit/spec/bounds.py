@@ -21,7 +21,7 @@ MAX_TEXT = 5000  # description, notes
 MAX_STRING = 500  # any other string (sources, plugin names, estimated fields, ...)
 MAX_BLOCK = 20000  # one carried URDF block (`urdf_blocks`: a Gazebo plugin's XML)
 MAX_ANY = 1e6  # any other number
-MAX_BODIES = 256  # links, joints, frames: every step is at least linear in them
+MAX_BODIES = 10000  # links, joints, frames: an import is near-linear in them (performance.md)
 MAX_ITEMS = 1000  # any other list
 
 #: field name -> (low, high, unit) on its absolute value; low applies to non-zero values only

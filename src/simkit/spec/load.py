@@ -35,8 +35,10 @@ class SourceDoc:
 
 #: Guards against hostile YAML: nesting depth, values after alias expansion, file size.
 MAX_DEPTH = 48
-MAX_NODES = 200_000
-MAX_BYTES = 4_000_000
+#: values and bytes: room for a spec of `bounds.MAX_BODIES` links (an imported chain of
+#: 10,000 links writes about 710,000 values in 6.6 MB, its report comments included)
+MAX_NODES = 1_000_000
+MAX_BYTES = 16_000_000
 #: a longer integer overflows float() (the bounds check would raise); shorter ones get the
 #: bounds' own message ("at most ...")
 MAX_INT_DIGITS = 308

@@ -253,15 +253,17 @@ def _floating(spec: RobotSpec) -> Iterator[Problem]:
 
 def _cycles(spec: RobotSpec) -> Iterator[Problem]:
     parent_of = {j.child: (j.parent, i) for i, j in enumerate(spec.joints)}
+    rooted: set[str] = set()  # links whose walk up reached a root: linear in a long chain
     for start in parent_of:
         seen = {start}
         node = start
-        while node in parent_of:
+        while node in parent_of and node not in rooted:
             node, index = parent_of[node]
             if node in seen:
                 yield ("joints", index, "parent"), f"joints form a loop through '{node}'"
                 return
             seen.add(node)
+        rooted |= seen
 
 
 def _first(problems: list[Problem], doc: SourceDoc) -> SpecError:
