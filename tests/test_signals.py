@@ -381,3 +381,19 @@ def test_sigterm_ends_pool_workers_instead_of_waiting_for_their_jobs(tmp_path):
     assert time.monotonic() - start < 60
     assert proc.returncode == 128 + signal.SIGTERM, err
     assert _tagged(tag) == []
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_the_viewer_cleanly(built, tmp_path):
+    """Ctrl-C is how `simkit view` stops: exit 0, no interrupted line, no traceback."""
+    kit = built / "kit" / "planar_2r_description"
+    cmd = _cli("view", str(kit), "--no-browser", "--port", "0")
+    proc = subprocess.Popen(
+        cmd, env=_env(tmp_path, "view"), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    line = proc.stderr.readline()  # "viewing ... (Ctrl-C stops)": the server is up
+    assert "Ctrl-C stops" in line, line
+    proc.send_signal(signal.SIGINT)
+    _out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, (proc.returncode, err)
+    assert "Traceback" not in err and "interrupted" not in err, err

@@ -38,6 +38,7 @@ class _Main(click.Group):
             with interrupt.installed():
                 return super().main(*args, **kwargs)
         except interrupt.Interrupted as exc:
+            interrupt.ignore()  # the clean-up is done: no late signal may end the exit
             err.print(f"simkit: {exc.line()}", markup=False)
             sys.exit(exc.code)
         except OSError as exc:  # click itself handles a closed pipe (EPIPE)

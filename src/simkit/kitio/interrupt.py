@@ -2,13 +2,15 @@
 
 Python's default SIGTERM (and SIGHUP) kill the process at once: no `finally` runs, so a
 build's staging folder, a publish's site folder and an import's `.import-*` folder stay
-behind, and forked workers may outlive it. `installed()` (the CLI entry) turns SIGTERM and
-SIGHUP into `Interrupted`, a `SystemExit` with the conventional code (128 + the signal: 143
-for SIGTERM), and SIGINT into `KeyboardInterrupt` as Python does (so code that stops on
-Ctrl-C, such as `simkit view`, still does; the CLI turns an unhandled one into
-`Interrupted`, 130). Either way every `finally` and context manager runs: staging folders
-are removed, locks released, forked children stopped and reaped. Further signals are
-ignored from then on, so the clean-up is not cut short.
+behind, and forked workers may outlive it. `installed()` (the CLI entry)
+turns each of them into `Interrupted`, a `SystemExit` with the conventional code (128 + the
+signal: 130 for SIGINT, 143 for SIGTERM). Not `KeyboardInterrupt` for SIGINT: a
+KeyboardInterrupt that passes through code a C extension runs with `PyRun_String`
+(pybind11's `exec`, while a library is imported) marks the interpreter, which then kills
+itself with SIGINT at exit (status -2) even after simkit handled it. Code that stops on
+Ctrl-C (`simkit view`) catches `Interrupted` with `signum == SIGINT`. Every `finally` and
+context manager runs: staging folders are removed, locks released, forked children stopped
+and reaped. Further signals are ignored from then on, so the clean-up is not cut short.
 
 `held()` marks a section that must finish once begun (publishing a kit's folder, zip and
 manifest): a signal that arrives inside it takes effect when the section ends. The Python
@@ -51,14 +53,18 @@ def _handler(signum: int, _frame: object) -> None:
     _interrupt(signum)
 
 
+def ignore() -> None:
+    """Ignore `SIGNALS` from now on (main thread only): a signal that arrives again, or
+    late, cannot cut a clean-up or an exit short."""
+    if threading.current_thread() is threading.main_thread():
+        for sig in SIGNALS:
+            signal.signal(sig, signal.SIG_IGN)
+
+
 def _interrupt(signum: int) -> None:
-    """Ignore further signals, stop pool workers, and raise `KeyboardInterrupt` (SIGINT) or
-    `Interrupted`."""
-    for sig in SIGNALS:
-        signal.signal(sig, signal.SIG_IGN)
+    """Ignore further signals, stop pool workers, and raise `Interrupted`."""
+    ignore()
     _stop_pool_workers()
-    if signum == signal.SIGINT:
-        raise KeyboardInterrupt
     raise Interrupted(signum)
 
 

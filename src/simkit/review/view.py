@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import mimetypes
+import signal
 import tempfile
 import threading
 from collections.abc import Callable
@@ -22,6 +23,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 from simkit.errors import SimkitError
+from simkit.kitio import interrupt
 
 WEB = Path(__file__).resolve().parent / "web"
 TYPES = {
@@ -153,16 +155,19 @@ def serve_kit(
             raise SimkitError(f"{kit}: no such kit folder or zip")
         server = start_server(folder, port)
         url = f"http://127.0.0.1:{server.server_address[1]}/"
-        if say is not None:
-            say(f"viewing {kit} at {url} (Ctrl-C stops)")
-        if open_browser:
-            import webbrowser
+        try:  # from the "Ctrl-C stops" line on, Ctrl-C is a clean stop
+            if say is not None:
+                say(f"viewing {kit} at {url} (Ctrl-C stops)")
+            if open_browser:
+                import webbrowser
 
-            webbrowser.open(url)
-        try:
+                webbrowser.open(url)
             threading.Event().wait()
-        except KeyboardInterrupt:
+        except KeyboardInterrupt:  # without the CLI's handlers (the library called directly)
             pass
+        except interrupt.Interrupted as stop:  # the CLI: Ctrl-C is the way to stop viewing
+            if stop.signum != signal.SIGINT:
+                raise
         finally:
             server.shutdown()
             server.server_close()
