@@ -1,7 +1,11 @@
-"""Time `simkit build` per robot, cold (empty cache) and warm (cache hit), as issue 3 asks.
+"""Time `simkit build` per robot: cold (empty cache), warm (cache hit) and no-op, as issues 3
+and 23 ask.
 
-For each robot: one cold build into an empty cache folder, then `--warm` warm rebuilds (the
-median is reported), each as its own `simkit build` process, so interpreter start-up and
+For each robot: one cold build into an empty cache folder and an empty output folder; then
+`--warm` warm builds, each into a fresh output folder (a full build whose steps all hit the
+cache); then `--noop` rebuilds into the cold build's folder, which change nothing (the no-op
+of kitio/noop.py). Medians are reported, with CPU seconds (user + system of the build and its
+child processes), each build as its own `simkit build` process, so interpreter start-up and
 imports count as a user sees them. Also reported: the CoACD share of the cold build (seconds
 of the links CoACD decomposed, from the build's plain log lines, over the cold wall time),
 collision pieces, and visual and collision triangles.
@@ -9,6 +13,7 @@ collision pieces, and visual and collision triangles.
     python scripts/bench.py                      # every robots/rosie_*.yaml
     python scripts/bench.py rosie_1000 tests/specs/collision_mix.yaml --warm 5 --json out.json
     python scripts/bench.py rosie_1000 --compare-step 3   # what the STEP assembly adds
+    python scripts/bench.py rosie_1000 /tmp/talos/talos.yaml --warm 1 --noop 5
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ LOG = re.compile(r"collision (\S+): (\w+), (\d+) pieces, ([\d.]+) s")
 
 def _build(
     target: str, out: Path, cache: Path, jobs: int | None, extra: tuple[str, ...] = ()
-) -> tuple[float, str]:
+) -> tuple[float, str, str]:
     cmd = [
         sys.executable,
         "-m",
@@ -55,22 +60,40 @@ def _build(
     CPU.append(sum(getattr(after, f) - getattr(before, f) for f in ("ru_utime", "ru_stime")))
     if done.returncode != 0:
         raise SystemExit(f"{target}: build failed:\n{done.stderr}")
-    return wall, done.stderr
+    return wall, done.stderr, done.stdout
 
 
 def _triangles(path: Path) -> int:
-    return int.from_bytes(path.read_bytes()[80:84], "little")
+    """Triangles of a kit mesh: a binary STL's count, or an OBJ's `f` lines (collision)."""
+    data = path.read_bytes()
+    if path.suffix == ".obj":
+        return sum(line.startswith(b"f ") for line in data.splitlines())
+    return int.from_bytes(data[80:84], "little")
 
 
-def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] = ()) -> dict:
+def bench(
+    target: str,
+    warm_runs: int,
+    jobs: int | None,
+    extra: tuple[str, ...] = (),
+    noop_runs: int = 0,
+) -> dict:
     with tempfile.TemporaryDirectory(prefix="simkit-bench-") as tmp:
         root = Path(tmp)
-        cold, log = _build(target, root / "out", root / "cache", jobs, extra)
+        cold, log, _ = _build(target, root / "out", root / "cache", jobs, extra)
         cold_cpu = CPU[-1]
         warm = [
-            _build(target, root / "out", root / "cache", jobs, extra)[0] for _ in range(warm_runs)
+            _build(target, root / f"warm{i}", root / "cache", jobs, extra)[0]
+            for i in range(warm_runs)
         ]
-        warm_cpu = statistics.median(CPU[-warm_runs:])
+        warm_cpu = statistics.median(CPU[-warm_runs:]) if warm_runs else float("nan")
+        noop = []
+        for _ in range(noop_runs):
+            wall, _, said = _build(target, root / "out", root / "cache", jobs, extra)
+            if "nothing changed" not in said:
+                raise SystemExit(f"{target}: a rebuild with nothing changed was no no-op: {said}")
+            noop.append(wall)
+        noop_cpu = statistics.median(CPU[-noop_runs:]) if noop_runs else float("nan")
         coacd = sum(float(m[3]) for m in LOG.findall(log) if m[1] == "coacd")
         kit = next((root / "out").glob("*_description"))
         doc = json.loads((kit / "robot.json").read_text())
@@ -86,10 +109,13 @@ def bench(target: str, warm_runs: int, jobs: int | None, extra: tuple[str, ...] 
     return {
         "robot": doc["name"],
         "cold_s": cold,
-        "warm_s": statistics.median(warm),
+        "warm_s": statistics.median(warm) if warm else float("nan"),
         "warm_runs_s": warm,
         "cold_cpu_s": cold_cpu,
         "warm_cpu_s": warm_cpu,
+        "noop_s": statistics.median(noop) if noop else float("nan"),
+        "noop_runs_s": noop,
+        "noop_cpu_s": noop_cpu,
         "coacd_links": sum(r["method"] == "coacd" for r in reports),
         "coacd_s": coacd,
         "coacd_share": coacd / cold,
@@ -109,6 +135,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("targets", nargs="*", help="robot names or spec paths (default: rosie_*)")
     parser.add_argument("--warm", type=int, default=3, help="warm rebuilds per robot (median)")
+    parser.add_argument("--noop", type=int, default=5, help="no-op rebuilds per robot (median)")
     parser.add_argument("--jobs", type=int, default=None, help="passed to simkit build --jobs")
     parser.add_argument("--json", type=Path, default=None, help="also write the rows here")
     parser.add_argument(
@@ -132,16 +159,22 @@ def main() -> None:
         from simkit.kitio.resources import robot_names
 
         targets = [n for n in robot_names() if n.startswith("rosie_")]
-    rows = [bench(t, args.warm, args.jobs) for t in targets]
-    print(f"cores: {len(os.sched_getaffinity(0))}, python {sys.version.split()[0]}")
+    rows = [bench(t, args.warm, args.jobs, noop_runs=args.noop) for t in targets]
     print(
-        "| robot | cold s | warm s | CoACD links | CoACD share | pieces (max/link) | "
-        "max hull/solid | max visual-to-collision mm | visual tris | collision tris |"
+        f"cores: {len(os.sched_getaffinity(0))}, python {sys.version.split()[0]}, "
+        f"load average {os.getloadavg()[0]:.2f}"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print(
+        "| robot | cold s (CPU s) | warm s (CPU s) | no-op s (CPU s) | CoACD links | "
+        "CoACD share | pieces (max/link) | max hull/solid | max visual-to-collision mm | "
+        "visual tris | collision tris |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print(
-            f"| {r['robot']} | {r['cold_s']:.2f} | {r['warm_s']:.2f} | {r['coacd_links']} | "
+            f"| {r['robot']} | {r['cold_s']:.2f} ({r['cold_cpu_s']:.2f}) | "
+            f"{r['warm_s']:.2f} ({r['warm_cpu_s']:.2f}) | "
+            f"{r['noop_s']:.3f} ({r['noop_cpu_s']:.3f}) | {r['coacd_links']} | "
             f"{100 * r['coacd_share']:.0f} % | {r['pieces']} ({r['max_pieces_per_link']}) | "
             f"{r['max_hull_volume_ratio']:.3f} | {r['max_visual_to_collision_mm']:.2f} | "
             f"{r['visual_triangles']} | {r['collision_triangles']} |"

@@ -9,6 +9,10 @@ exit-0 kits that `simkit check` rejects.
 
     python scripts/fuzz_specs.py --count 10000 --seed 1 --work /tmp/fuzz [--max-seconds N]
     python scripts/fuzz_specs.py --count 10000 --seed 2 --validate-only   # no builds
+    python scripts/fuzz_specs.py --count 10000 --seed 1 --ray [--resume]  # shards on Ray
+
+Each spec i is mutated from its own seed (SEED:i), so shards run anywhere in any order, a
+stopped run continues with --resume (WORK/results.jsonl), and equal seeds give equal tables.
 
 Mutations (seeded, so a run is reproducible): perturb a number (mostly still valid, so it
 builds), set a field to a hostile value, delete or add a key, copy a list item, or edit the
@@ -147,7 +151,9 @@ def _children_cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -> str:
+def run_one(
+    spec: Path, out: Path, stats: dict, env: dict, build: bool = True, extra: tuple = ()
+) -> str:
     """Validate, then build and check; returns the outcome name it counted."""
     from simkit.errors import SpecError
     from simkit.spec.validate import load_spec
@@ -163,6 +169,7 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -
     if not build:
         return "valid_not_built"
     cmd = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out), "-q"]
+    cmd += list(extra)
     start, cpu = time.monotonic(), _children_cpu()
     try:
         proc = subprocess.run(
@@ -206,22 +213,98 @@ def run_one(spec: Path, out: Path, stats: dict, env: dict, build: bool = True) -
     return "built_ok" if check.returncode == 0 else "check_rejects_exit0_kit"
 
 
-def _summary(args, done: int, counts: dict, stats: dict, begin: float) -> dict:
-    """The figures so far, also written to WORK/summary.json (after every spec)."""
-    seconds = stats["build_seconds"]
+def run_shard(
+    spec_text: str, seed: int, indices: list[int], work: str, build: bool, extra: tuple = ()
+) -> list:
+    """Mutate and run the specs `indices` (each from its own seed, so any shard can run on
+    any machine, in any order, and a stopped run resumes); one result dict per spec."""
+    data = yaml.safe_load(spec_text)
+    env = {**os.environ}
+    if (REPO / "src").is_dir():  # this checkout's simkit first
+        env["PYTHONPATH"] = os.pathsep.join(
+            filter(None, [str(REPO / "src"), env.get("PYTHONPATH")])
+        )
+    root = Path(work) / f"shard-{indices[0]:05d}"  # private: shards run side by side
+    root.mkdir(parents=True, exist_ok=True)
+    results = []
+    for i in indices:
+        case = root / f"{i:05d}"
+        shutil.rmtree(case, ignore_errors=True)
+        case.mkdir()
+        spec, out = case / "spec.yaml", case / "out"
+        mutated, _what = mutate(spec_text, data, random.Random(f"{seed}:{i}"))
+        spec.write_bytes(mutated.encode("utf-8", "surrogatepass"))
+        stats: dict = {"build_seconds": [], "build_cpu_seconds": []}
+        before = _listing(root, out)
+        outcome = run_one(spec, out, stats, env, build=build, extra=extra)
+        outside = _listing(root, out) != before
+        if outcome in ("refused", "built_ok", "build_refused", "valid_not_built"):
+            shutil.rmtree(case, ignore_errors=True)
+        results.append({"index": i, "outcome": outcome, "outside": outside, **stats})
+    return results
+
+
+def _summary(args, results: dict[int, dict], begin: float) -> dict:
+    """The figures so far, from every result of this work folder (resumed ones too), also
+    written to WORK/summary.json. The same seeds give the same outcome table."""
+    counts: dict[str, int] = {}
+    seconds, cpu, examples, refusals = [], [], [], set()
+    for _i, result in sorted(results.items()):
+        counts[result["outcome"]] = counts.get(result["outcome"], 0) + 1
+        if result["outside"]:
+            counts["files_outside_out"] = counts.get("files_outside_out", 0) + 1
+        seconds += result["build_seconds"]
+        cpu += result["build_cpu_seconds"]
+        examples += result.get("examples", [])
+        refusals.update(result.get("build_refusals", []))
     summary = {
-        "specs": done,
+        "specs": len(results),
         "seed": args.seed,
         "outcomes": dict(sorted(counts.items())),
         "builds": len(seconds),
         "longest_build_s": round(max(seconds), 1) if seconds else 0.0,
-        "longest_build_cpu_s": round(max(stats["build_cpu_seconds"], default=0.0), 1),
+        "longest_build_cpu_s": round(max(cpu, default=0.0), 1),
         "wall_s": round(time.monotonic() - begin, 1),
-        "examples": stats.get("examples", [])[:5],
-        "build_refusals": sorted(set(stats.get("build_refusals", [])))[:20],
+        "specs_per_minute": round(len(results) / max(time.monotonic() - begin, 1e-9) * 60, 1),
+        "examples": examples[:5],
+        "build_refusals": sorted(refusals)[:20],
     }
     (args.work / "summary.json").write_text(json.dumps(summary, indent=2))
     return summary
+
+
+def _shards(todo: list[int], size: int) -> list[list[int]]:
+    return [todo[k : k + size] for k in range(0, len(todo), size)]
+
+
+def _run_serial(args, text: str, todo: list[int], record) -> None:
+    for shard in _shards(todo, args.shard_size):
+        if args.max_seconds and time.monotonic() - args.begin > args.max_seconds:
+            break
+        work = str(args.work / "cases")
+        record(run_shard(text, args.seed, shard, work, not args.validate_only, args.extra))
+
+
+def _run_ray(args, text: str, todo: list[int], record) -> None:
+    """One Ray task per shard on the cluster in RAY_ADDRESS (else a local Ray); results are
+    recorded as shards finish, so a stopped run resumes with --resume."""
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(address=os.environ.get("RAY_ADDRESS") or None, include_dashboard=False)
+    task = ray.remote(num_cpus=1, max_retries=2)(run_shard)
+    work = str(args.work / "cases")
+    pending = [
+        task.remote(text, args.seed, shard, work, not args.validate_only, args.extra)
+        for shard in _shards(todo, args.shard_size)
+    ]
+    while pending:
+        done, pending = ray.wait(pending, num_returns=1)
+        record(ray.get(done[0]))
+        if args.max_seconds and time.monotonic() - args.begin > args.max_seconds:
+            for ref in pending:
+                ray.cancel(ref, force=True)
+            break
 
 
 def main() -> None:
@@ -234,39 +317,41 @@ def main() -> None:
     parser.add_argument(
         "--validate-only", action="store_true", help="no builds: validation outcomes only"
     )
+    parser.add_argument("--ray", action="store_true", help="one Ray task per shard")
+    parser.add_argument("--shard-size", type=int, default=10, help="specs per shard")
+    parser.add_argument(
+        "--resume", action="store_true", help="keep WORK's results; run only the specs left"
+    )
+    parser.add_argument("--start", type=int, default=0, help="first spec index (a shard range)")
+    parser.add_argument("--no-step", action="store_true", help="build with --no-step")
     args = parser.parse_args()
+    args.extra = ("--no-step",) if args.no_step else ()
     sys.path.insert(0, str(REPO / "src"))
-    env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
     text = args.spec.read_text()
-    data = yaml.safe_load(text)
-    rng = random.Random(args.seed)
-    shutil.rmtree(args.work, ignore_errors=True)
-    args.work.mkdir(parents=True)
-    stats: dict = {"build_seconds": [], "build_cpu_seconds": []}
-    counts: dict[str, int] = {}
-    begin = time.monotonic()
-    done = 0
-    for i in range(args.count):
-        if args.max_seconds and time.monotonic() - begin > args.max_seconds:
-            break
-        case = args.work / f"{i:05d}"
-        case.mkdir()
-        spec, out = case / "spec.yaml", case / "out"
-        mutated, _what = mutate(text, data, rng)
-        spec.write_bytes(mutated.encode("utf-8", "surrogatepass"))
-        before = _listing(args.work, out)
-        outcome = run_one(spec, out, stats, env, build=not args.validate_only)
-        if _listing(args.work, out) != before:
-            counts["files_outside_out"] = counts.get("files_outside_out", 0) + 1
-        counts[outcome] = counts.get(outcome, 0) + 1
-        if outcome in ("refused", "built_ok", "build_refused", "valid_not_built"):
-            shutil.rmtree(case, ignore_errors=True)
-        done += 1
-        _summary(args, done, counts, stats, begin)
-    summary = _summary(args, done, counts, stats, begin)
+    results_file = args.work / "results.jsonl"
+    if not args.resume:
+        shutil.rmtree(args.work, ignore_errors=True)
+    args.work.mkdir(parents=True, exist_ok=True)
+    results: dict[int, dict] = {}
+    if results_file.is_file():
+        for line in results_file.read_text().splitlines():
+            result = json.loads(line)
+            results[result["index"]] = result
+    todo = [i for i in range(args.start, args.count) if i not in results]
+    args.begin = time.monotonic()
+
+    def record(shard: list[dict]) -> None:
+        with results_file.open("a") as stream:
+            for result in shard:
+                stream.write(json.dumps(result, sort_keys=True) + "\n")
+                results[result["index"]] = result
+        _summary(args, results, args.begin)
+
+    (_run_ray if args.ray else _run_serial)(args, text, todo, record)
+    summary = _summary(args, results, args.begin)
     print(json.dumps(summary, indent=2))
     bad = ("traceback", "over_60s", "files_outside_out", "check_rejects_exit0_kit", "bad_refusal")
-    sys.exit(1 if any(counts.get(k) for k in bad) else 0)
+    sys.exit(1 if any(summary["outcomes"].get(k) for k in bad) else 0)
 
 
 if __name__ == "__main__":

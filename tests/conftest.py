@@ -46,6 +46,16 @@ def rosie_1000_published(tmp_path_factory) -> tuple[Path, dict]:
     return out, publish(out, ["rosie_1000"], cache=Cache.disabled())
 
 
+#: The five seed robots (robots/*.yaml).
+SEED_ROBOTS = ("asimov", "ecn_2r", "rosie_1000", "rosie_1400", "rosie_600")
+
+
+@pytest.fixture(scope="session")
+def seed_kits(kit_factory) -> dict[str, BuildResult]:
+    """Every seed robot's kit, built once per session (shared with `kit_factory`)."""
+    return {name: kit_factory(name) for name in SEED_ROBOTS}
+
+
 def pytest_addoption(parser):
     parser.addoption(
         "--update-golden",
@@ -55,7 +65,7 @@ def pytest_addoption(parser):
 
 
 #: Fixtures that build (and check) real kits: a test using any of them is in the slow tier.
-KIT_FIXTURES = {"kit_factory", "rosie_1000", "rosie_1000_published"}
+KIT_FIXTURES = {"kit_factory", "rosie_1000", "rosie_1000_published", "seed_kits"}
 
 
 def pytest_collection_modifyitems(config, items):

@@ -1,5 +1,7 @@
-"""Crash-consistent publishing (atomic.py): kill -9 at every step leaves the visible kit and
-zip from one build, old or new; the next build cleans up; concurrent builds serialize."""
+"""Crash-safe publishing (atomic.py): the kit is a plain folder and the zip a plain file in
+--out. A kill -9 at every step leaves the kit and zip of one build, or a mismatch that the
+manifest reports and the next build repairs; concurrent builds serialize; a build that
+changes nothing writes nothing."""
 
 from __future__ import annotations
 
@@ -14,30 +16,33 @@ from pathlib import Path
 import pytest
 
 from simkit.check.generated import kit_files
-from simkit.kitio import atomic, layout
+from simkit.kitio import atomic, layout, manifest
 from simkit.kitio.archive import read_zip, zip_bytes
 
 ROBOT = "toy"
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 
-#: A child process that publishes a synthetic kit (files named by `tag`) with the real code.
+#: A child process that publishes a synthetic kit (files named by `tag`) with the real code;
+#: argv[4] == "0" takes renameat2 away (the two-rename path of systems without it).
 PUBLISH = """
 import sys
 from pathlib import Path
-from simkit.kitio import atomic
-from simkit.kitio import layout
+from simkit.kitio import atomic, layout, manifest
 from simkit.kitio.archive import zip_bytes
 out, robot, tag = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+if sys.argv[4] == "0":
+    atomic._exchange = lambda a, b: False
 files = {"robot.json": tag.encode(), f"meshes/{tag}.stl": tag.encode() * 100, "a/b.txt": b"x"}
+zip_data = zip_bytes(files, layout.kit_dir_name(robot))
 with atomic.locked(out):
-    atomic.repair(out, robot)
-    staged = atomic.staging(out, robot)
-    kit = staged / layout.kit_dir_name(robot)
-    for rel, data in files.items():
-        (kit / rel).parent.mkdir(parents=True, exist_ok=True)
-        (kit / rel).write_bytes(data)
-    (staged / layout.zip_name(robot)).write_bytes(zip_bytes(files, layout.kit_dir_name(robot)))
-    atomic.commit(staged, out, robot)
+    said = atomic.repair(out, robot)
+    if said:
+        print(said, file=sys.stderr)
+    with atomic.staging_area(out, robot) as staged:
+        atomic.stage_kit(staged, out, robot, files)
+        atomic.stage_file(staged, out, layout.zip_name(robot), zip_data)
+        atomic.stage_file(staged, out, manifest.name(robot), manifest.make(robot, files, zip_data))
+        print("changed" if atomic.commit(staged, out, robot) else "unchanged")
 """
 
 
@@ -45,80 +50,160 @@ def _files(tag: str) -> dict[str, bytes]:
     return {"robot.json": tag.encode(), f"meshes/{tag}.stl": tag.encode() * 100, "a/b.txt": b"x"}
 
 
-def _publish(out: Path, tag: str, kill_at: str | None = None) -> int:
+def _publish(
+    out: Path, tag: str, kill_at: str | None = None, exchange: bool = True
+) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": SRC}
     env.pop(atomic.KILL_ENV, None)
     if kill_at:
         env[atomic.KILL_ENV] = kill_at
-    cmd = [sys.executable, "-c", PUBLISH, str(out), ROBOT, tag]
-    return subprocess.run(cmd, env=env, timeout=60).returncode
+    cmd = [sys.executable, "-c", PUBLISH, str(out), ROBOT, tag, "1" if exchange else "0"]
+    return subprocess.run(cmd, env=env, timeout=60, capture_output=True, text=True)
 
 
-def _visible(out: Path) -> tuple[dict[str, bytes], dict[str, bytes]] | None:
-    """(kit files, zip files) as a user sees them, or None when neither exists."""
-    kit, zip_path = out / layout.kit_dir_name(ROBOT), out / layout.zip_name(ROBOT)
-    if not kit.exists() and not zip_path.exists():
-        return None
-    assert kit.is_dir() and zip_path.is_file(), sorted(p.name for p in out.iterdir())
-    files, problems = kit_files(kit)
-    assert not problems
-    return {rel: p.read_bytes() for rel, p in files.items()}, read_zip(zip_path.read_bytes())
+def _kit(out: Path) -> Path:
+    return out / layout.kit_dir_name(ROBOT)
+
+
+def _visible(
+    out: Path, plain: bool = True
+) -> tuple[dict[str, bytes] | None, dict[str, bytes] | None]:
+    """(kit files, zip files) as a user sees them; None for a missing one. `plain`: both
+    must be a plain folder and file (else links of the previous layout are followed)."""
+    kit, zip_path = _kit(out), out / layout.zip_name(ROBOT)
+    if plain:
+        assert not kit.is_symlink() and not zip_path.is_symlink()
+    kit, zip_path = kit.resolve(), zip_path.resolve()
+    seen_kit = seen_zip = None
+    if kit.exists():
+        files, problems = kit_files(kit)
+        assert not problems
+        seen_kit = {rel: p.read_bytes() for rel, p in files.items()}
+    if zip_path.exists():
+        seen_zip = read_zip(zip_path.read_bytes())
+    return seen_kit, seen_zip
 
 
 def _legacy(out: Path, tag: str) -> None:
-    """A plain kit folder and zip, as simkit wrote them before atomic.py."""
-    out.mkdir(parents=True, exist_ok=True)
-    kit = out / layout.kit_dir_name(ROBOT)
+    """The generation layout of the previous simkit: kit and zip are links into
+    `.NAME.current`, itself a link to a `.NAME.<id>.gen` folder."""
+    gen = out / f".{ROBOT}.0a1b2c3d.gen"
     for rel, data in _files(tag).items():
-        (kit / rel).parent.mkdir(parents=True, exist_ok=True)
-        (kit / rel).write_bytes(data)
+        path = gen / layout.kit_dir_name(ROBOT) / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
     zip_data = zip_bytes(_files(tag), layout.kit_dir_name(ROBOT))
-    (out / layout.zip_name(ROBOT)).write_bytes(zip_data)
+    (gen / layout.zip_name(ROBOT)).write_bytes(zip_data)
+    os.symlink(gen.name, out / f".{ROBOT}.current")
+    for name in (layout.kit_dir_name(ROBOT), layout.zip_name(ROBOT)):
+        os.symlink(f".{ROBOT}.current/{name}", out / name)
 
 
-LEGACY_STEPS = atomic.STEPS[2:6]
-CASES = [(step, False) for step in atomic.STEPS if step not in LEGACY_STEPS]
-CASES += [(step, True) for step in atomic.STEPS]
+#: Steps after which the new kit is in place but the zip may still be the old one.
+MISMATCH_STEPS = {"kit_aside", "kit_swapped"}
+CASES = [
+    (step, start, exchange)
+    for start in ("plain", "legacy")
+    for exchange in (True, False)
+    for step in atomic.STEPS
+]
 
 
 @pytest.mark.parametrize(
-    "kill_at,legacy", CASES, ids=[f"{s}-{'legacy' if lg else 'generations'}" for s, lg in CASES]
+    "kill_at,start,exchange",
+    CASES,
+    ids=[f"{s}-{st}-{'renameat2' if ex else 'two_renames'}" for s, st, ex in CASES],
 )
-def test_kill_at_each_step_leaves_one_build(tmp_path, kill_at, legacy):
+def test_kill_at_each_step_leaves_one_build_or_a_reported_mismatch(
+    tmp_path, kill_at, start, exchange
+):
     out = tmp_path / "out"
-    if legacy:
+    out.mkdir()
+    if start == "legacy":
         _legacy(out, "old")
     else:
-        assert _publish(out, "old") == 0
-    code = _publish(out, "new", kill_at)
-    assert code == -9  # every step is reached (legacy_* ones only from a plain kit)
-    kit, zipped = _visible(out)
-    assert kit == zipped, "kit and zip come from different builds"
-    assert kit in (_files("old"), _files("new"))
-    if kill_at in ("switched", "linked", "cleaned"):
-        assert kit == _files("new")
-    # the next build recovers: consistent, and nothing stale is left
-    assert _publish(out, "next") == 0
-    kit, zipped = _visible(out)
-    assert kit == zipped == _files("next")
-    hidden = sorted(p.name for p in out.iterdir() if p.name.startswith("."))
-    assert len(hidden) == 2 and f".{ROBOT}.current" in hidden, hidden
-    assert os.readlink(out / f".{ROBOT}.current") in hidden
+        assert _publish(out, "old", exchange=exchange).returncode == 0
+    killed = _publish(out, "new", kill_at, exchange)
+    reached = not (kill_at == "kit_aside" and exchange)  # that step is the fallback's
+    assert killed.returncode == (-9 if reached else 0), killed.stderr
+    seen = _visible(out, plain=start == "plain")
+    kit_seen, zip_seen = seen
+    if kit_seen is not None and kit_seen == zip_seen:
+        assert kit_seen in (_files("old"), _files("new"))
+    else:  # the new kit beside the old zip (or no kit: two renames): reported, not silent
+        assert kill_at in MISMATCH_STEPS, (kill_at, seen)
+        assert "interrupted" in manifest.mismatch(_kit(out))
+    if kill_at in ("zip_moved", "manifest_moved", "journal_closed", "cleaned"):
+        assert kit_seen == zip_seen == _files("new")
+    # the next build finishes the publish (one line), then publishes its own kit
+    done = _publish(out, "next", exchange=exchange)
+    assert done.returncode == 0 and done.stdout.strip() == "changed"
+    journaled = reached and atomic.STEPS.index(kill_at) >= atomic.STEPS.index("journaled")
+    if journaled and kill_at not in ("journal_closed", "cleaned"):
+        assert len(done.stderr.strip().splitlines()) == 1 and "killed" in done.stderr
+    else:
+        assert done.stderr == ""
+    assert _visible(out) == (_files("next"), _files("next"))
+    assert manifest.mismatch(_kit(out)) is None
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        [f".{ROBOT}.manifest.json", layout.kit_dir_name(ROBOT), layout.zip_name(ROBOT)]
+    )
 
 
-def test_kill_on_first_build_leaves_nothing_or_new(tmp_path):
+@pytest.mark.parametrize("exchange", [True, False], ids=["renameat2", "two_renames"])
+def test_kill_on_first_build_leaves_nothing_new_or_a_reported_gap(tmp_path, exchange):
     for kill_at in atomic.STEPS:
         out = tmp_path / kill_at
-        _publish(out, "new", kill_at)
-        seen = _visible(out)
-        assert seen is None or seen[0] == seen[1] == _files("new"), kill_at
+        _publish(out, "new", kill_at, exchange)
+        kit_seen, zip_seen = _visible(out)
+        if kit_seen != zip_seen:
+            assert kill_at == "kit_swapped" and "interrupted" in manifest.mismatch(_kit(out))
+        assert kit_seen in (None, _files("new")), kill_at
+        assert _publish(out, "new", exchange=exchange).returncode == 0
+        assert _visible(out) == (_files("new"), _files("new"))
+
+
+def _snapshot(out: Path) -> dict[str, tuple]:
+    """Every entry under `out` (itself included): kind, bytes, inode and mtime."""
+    seen = {}
+    for path in [out, *sorted(out.rglob("*"))]:
+        st = path.lstat()
+        data = path.read_bytes() if path.is_file() else None
+        seen[path.relative_to(out).as_posix()] = (st.st_mode, data, st.st_ino, st.st_mtime_ns)
+    return seen
+
+
+def test_a_build_that_changes_nothing_writes_nothing(tmp_path):
+    out = tmp_path / "out"
+    assert _publish(out, "same").stdout.strip() == "changed"
+    before = _snapshot(out)
+    time.sleep(0.01)
+    assert _publish(out, "same").stdout.strip() == "unchanged"
+    assert _snapshot(out) == before
+
+
+def test_a_changed_build_keeps_the_unchanged_files_inode_and_mtime(tmp_path):
+    out = tmp_path / "out"
+    assert _publish(out, "one").returncode == 0
+    before = _snapshot(out)
+    time.sleep(0.01)
+    assert _publish(out, "two").stdout.strip() == "changed"
+    after = _snapshot(out)
+    same = f"{layout.kit_dir_name(ROBOT)}/a/b.txt"
+    assert after[same] == before[same]  # the same inode, so the same mtime
+    folder = f"{layout.kit_dir_name(ROBOT)}/a"  # a new folder with the same entries and mtime
+    assert after[folder][3] == before[folder][3]
+    changed = f"{layout.kit_dir_name(ROBOT)}/robot.json"
+    assert after[changed][1] == b"two" and after[changed][3] > before[changed][3]
+    doc = json.loads((out / manifest.name(ROBOT)).read_bytes())
+    assert doc["zip_sha256"] == manifest.sha256((out / layout.zip_name(ROBOT)).read_bytes())
 
 
 def test_concurrent_publishes_serialize(tmp_path):
     out = tmp_path / "out"
     codes: list[int] = []
     threads = [
-        threading.Thread(target=lambda t=tag: codes.append(_publish(out, t)))
+        threading.Thread(target=lambda t=tag: codes.append(_publish(out, t).returncode))
         for tag in ("a", "b", "c", "d")
     ]
     for thread in threads:
@@ -129,7 +214,10 @@ def test_concurrent_publishes_serialize(tmp_path):
     assert codes == [0, 0, 0, 0]
     kit, zipped = _visible(out)
     assert kit == zipped and kit in [_files(t) for t in "abcd"]
-    assert not list(out.glob("*.staging")) and len(list(out.glob(".*.gen"))) == 1
+    assert manifest.mismatch(_kit(out)) is None
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [
+        f".{ROBOT}.manifest.json"
+    ]
 
 
 def test_out_on_a_file_or_unwritable_folder_is_one_line(tmp_path):
@@ -148,10 +236,36 @@ def test_out_on_a_file_or_unwritable_folder_is_one_line(tmp_path):
             pass
 
 
+def test_check_reports_a_zip_from_another_build_in_one_line_and_writes_nothing(tmp_path):
+    """`simkit check KIT` compares the kit and the zip with the manifest beside them."""
+    out = tmp_path / "out"
+    assert _publish(out, "one").returncode == 0
+    other = tmp_path / "other"
+    assert _publish(other, "two").returncode == 0
+    os.replace(other / layout.zip_name(ROBOT), out / layout.zip_name(ROBOT))
+    before = _snapshot(out)
+    proc = subprocess.run(
+        [sys.executable, "-m", "simkit.cli", "check", str(_kit(out))],
+        env={**os.environ, "PYTHONPATH": SRC},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode != 0 and proc.stdout == ""
+    (line,) = proc.stderr.strip().splitlines()
+    assert "different builds" in line and "the zip" in line and "Traceback" not in line
+    assert _snapshot(out) == before
+    # the kit from another build instead: named as the kit
+    assert _publish(out, "one").returncode == 0  # repairs: the zip is republished
+    assert manifest.mismatch(_kit(out)) is None
+    (_kit(out) / "robot.json").write_bytes(b"tampered")
+    assert "the kit does not match" in manifest.mismatch(_kit(out))
+
+
 @pytest.mark.slow
 def test_kill_a_real_build_at_each_step(tmp_path):
     """`simkit build` killed (SIGKILL, via the test hook) at each publishing step: the kit
-    and zip on disk are always one build's, and the next build recovers."""
+    and zip on disk are one build's or reported as a mismatch, and the next build repairs."""
     spec = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"
     variants = {}
     for tag in ("A", "B"):
@@ -160,6 +274,7 @@ def test_kill_a_real_build_at_each_step(tmp_path):
         path.write_text(spec.read_text().replace("title: Planar 2R", f"title: Planar 2R {tag}"))
         variants[tag] = path
     out = tmp_path / "out"
+    kit = out / "planar_2r_description"
 
     def build(tag: str, kill_at: str | None = None) -> int:
         env = {**os.environ, "PYTHONPATH": SRC}
@@ -170,20 +285,24 @@ def test_kill_a_real_build_at_each_step(tmp_path):
         return subprocess.run([*cmd, "--out", str(out)], env=env, timeout=600).returncode
 
     def title() -> str:
-        kit = out / "planar_2r_description"
         files, problems = kit_files(kit)
-        assert not problems
+        assert not problems and not kit.is_symlink()
         zipped = read_zip((out / "planar-2r-sim-kit.zip").read_bytes())
         assert zipped == {rel: p.read_bytes() for rel, p in files.items()}
         return json.loads(zipped["robot.json"])["title"]
 
     assert build("A") == 0 and title() == "Planar 2R A"
     old = "A"
-    for kill_at in ("locked", "staged", "generation", "switched", "linked", "cleaned"):
+    for kill_at in ("locked", "journaled", "kit_swapped", "zip_moved", "cleaned"):
         new = "B" if old == "A" else "A"
         assert build(new, kill_at) == -9, kill_at
+        if kill_at == "kit_swapped":  # the new kit beside the old zip: reported
+            assert "interrupted" in manifest.mismatch(kit)
+            assert build(new) == 0
         seen = title()
         assert seen in (f"Planar 2R {old}", f"Planar 2R {new}"), kill_at
         old = seen[-1]
     assert build("A") == 0 and title() == "Planar 2R A"
-    assert not list(out.glob(".*.staging")) and len(list(out.glob(".*.gen"))) == 1
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        [".planar_2r.manifest.json", "planar-2r-sim-kit.zip", "planar_2r_description"]
+    )

@@ -71,10 +71,10 @@ def test_old_format_entry_is_a_silent_miss(tmp_path, capsys):
     key = make_key("s", 1, [b"a"], {})
     path = cache.path("s", key)
     path.parent.mkdir(parents=True)
-    from simkit.kitio.cache import _DIGEST, _content_digest
+    from simkit.kitio.entry import DIGEST, content_digest
 
     arrays = {"v": np.arange(3.0)}
-    arrays[_DIGEST] = np.frombuffer(_content_digest(arrays).encode(), dtype=np.uint8)
+    arrays[DIGEST] = np.frombuffer(content_digest(arrays).encode(), dtype=np.uint8)
     buf = io.BytesIO()
     np.savez(buf, **arrays)
     path.write_bytes(buf.getvalue())

@@ -17,6 +17,7 @@ from simkit.derive import per_link as linkwork
 from simkit.derive.solids import to_mesh
 from simkit.errors import SpecError
 from simkit.kitio.cache import Cache
+from simkit.kitio.obj import read_mesh
 from simkit.kitio.resources import robot_names
 from simkit.kitio.stl import from_stl
 from simkit.model.robot import Mesh
@@ -81,7 +82,7 @@ def test_rosie_1000_kit_writes_the_pieces_and_their_quality(rosie_1000):
     for link in doc["links"]:
         paths = link["mesh"]["collision"]
         assert paths and reports[link["name"]]["pieces"] == len(paths)
-        pieces = [from_stl((kit / p).read_bytes()) for p in paths]
+        pieces = [read_mesh(p, (kit / p).read_bytes()) for p in paths]
         assert all(_trimesh(p).is_convex for p in pieces), link["name"]
         visual = from_stl((kit / link["mesh"]["visual"]).read_bytes()).vertices
         depth = np.min([_outside(visual, p.vertices, p.faces) for p in pieces], axis=0)

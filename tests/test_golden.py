@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from simkit.emit import docs, mjcf, robot_json, ros2, ros2_control, srdf, urdf
+from simkit.emit import docs, mjcf, robot_json, ros2, ros2_control, sdf, srdf, urdf
 from simkit.kitio.jsonout import dumps
 from simkit.model.robot import SimReports
 from simkit.pipeline import model_from_spec
@@ -30,6 +30,7 @@ EMITTERS = {
     "urdf": urdf.emit,
     "mjcf": mjcf.emit,
     "srdf": srdf.emit,
+    "sdf": sdf.emit,
     "docs": docs.emit,
     "ros2": ros2.emit,
     "robot_json": _robot_json,

@@ -276,3 +276,131 @@ def test_link_without_solid_or_inertia_is_refused(tmp_path):
         "    solid:\n    collision: primitives\n", "    solid: []\n    collision: primitives\n", 1
     )
     _refused(tmp_path, text, "links[0].solid", "needs inertia and com")
+
+
+# --- issue 24: numbers and keys that crashed, a pedestal beside the arm, stiff free fall ---
+
+HUGE = [
+    ("seed_400", "seed: 1\n", f"seed: {'9' * 400}\n", "seed", "400 digits"),
+    ("mass_400", "    mass: 2.0\n", f"    mass: {'9' * 400}\n", "links[0].mass", "400 digits"),
+    ("pose_5000", "  home: [0, 0]\n", f"  home: [{'1' * 5000}, 0]\n", "poses_deg.home[0]", "5000"),
+]
+
+
+@pytest.mark.parametrize("case", HUGE, ids=[c[0] for c in HUGE])
+def test_a_huge_integer_is_one_line(tmp_path, case):
+    """A 400-digit seed raised OverflowError (float()); 5000 digits hit Python's int limit."""
+    _, old, new, field, message = case
+    _refused(tmp_path, _edit(old, new), field, message)
+
+
+@pytest.mark.parametrize(
+    "old, new, field",
+    [
+        ("    mass: 2.0\n", '    mass: 2.0\n    "ab\\ncd": 1\n', "links[0]"),
+        ("seed: 1\n", 'seed: 1\n"x\\ny": 2\n', "<root>"),
+        ("seed: 1\n", 'seed: 1\n"x\\ty": 2\n', "<root>"),
+    ],
+    ids=["link_key", "root_key", "tab_key"],
+)
+def test_a_key_with_an_escaped_newline_is_one_line(tmp_path, old, new, field):
+    err = _refused(tmp_path, _edit(old, new), field, "not one line of printable text")
+    assert "\n" not in str(err)
+
+
+PEDESTAL = """  - name: pedestal
+    mass: 1.0
+    solid:
+      - {shape: box, size: [0.1, 0.1, 0.1], xyz: [0.5, 0, 0.05]}
+    collision: primitives
+  - name: pan
+    mass: 0.5
+    solid:
+      - {shape: box, size: [0.05, 0.05, 0.05], xyz: [0, 0, 0.025]}
+    collision: primitives
+"""
+PAN_JOINTS = """  - name: pan_joint
+    parent: pedestal
+    child: pan
+    xyz: [0.5, 0, 0.1]
+    axis: [0, 0, 1]
+    lower_deg: -90
+    upper_deg: 90
+    effort_peak: 5
+    max_velocity_deg_s: 90
+  - name: pedestal_joint
+    type: fixed
+    parent: world
+    child: pedestal
+"""
+
+
+@pytest.mark.slow
+def test_a_pedestal_with_a_joint_listed_first_builds(tmp_path):
+    """A fixed pedestal off `world` carrying a pan joint listed before the arm's joints: the
+    SRDF emitter raised KeyError 'world' (its group started at the pan joint's parent, off
+    the tool's chain). The base frame and the group now start on the tool's chain."""
+    from simkit.pipeline import build
+
+    text = GOOD.replace("root: base_footprint", "root: world")
+    text = text.replace("parent: base_footprint", "parent: world")
+    text = text.replace("links:\n", "links:\n" + PEDESTAL, 1)
+    text = text.replace("joints:\n", "joints:\n" + PAN_JOINTS, 1)
+    for pose in ("home: [0, 0]", "work: [30, 30]", "stretched: [0, 0]"):
+        text = text.replace(pose, pose.replace("[", "[0, "))
+    result = build(str(_spec(tmp_path, text, "planar_2r.yaml")), tmp_path / "out")
+    assert all(f.ok for f in result.findings)
+    srdf = (result.kit_dir / "srdf" / "planar_2r.srdf").read_text()
+    assert '<chain base_link="base_link" tip_link="tool0" />' in srdf
+    assert '<joint name="joint_1"' in srdf and '<joint name="pan_joint"' not in srdf
+
+
+def test_free_fall_integration_has_an_evaluation_budget():
+    """The independent integration stops at its budget (joint friction 1e5 N m made it run
+    for minutes); the refusal names the limit."""
+    import numpy as np
+
+    from simkit.model import rnea
+    from simkit.pipeline import model_from_spec
+
+    robot = model_from_spec("ecn_2r")
+    q0 = np.asarray(robot.pose(robot.freefall.pose), float)
+    times = np.arange(201) * 0.01
+    with pytest.raises(rnea.EvaluationBudget, match="more than 50 dynamics evaluations"):
+        rnea.integrate(robot, q0, 2.0, times, max_evals=50)
+
+
+@pytest.mark.slow
+def test_joint_friction_1e5_is_refused_in_one_line(tmp_path):
+    """ecn_2r with joint friction 1e5 N m: one line naming the budget, in seconds, not
+    minutes."""
+    import time
+
+    from simkit.simulate.freefall import MAX_EVALS
+
+    text = (REPO / "robots" / "ecn_2r.yaml").read_text()
+    assert "    friction: 0.01 " in text
+    spec = _spec(
+        tmp_path, text.replace("    friction: 0.01 ", "    friction: 100000.0 ", 1), "ecn_2r.yaml"
+    )
+    start = time.monotonic()
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "simkit.cli",
+            "build",
+            str(spec),
+            "--out",
+            str(tmp_path / "o"),
+            "-q",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert time.monotonic() - start < 120
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    line = result.stderr.strip()
+    assert "\n" not in line and f"budget of {MAX_EVALS} dynamics evaluations" in line, line
+    assert not (tmp_path / "o" / "ecn_2r_description").exists()

@@ -119,8 +119,8 @@ def test_package_dir_and_ros_package_path(tmp_path, monkeypatch):
     copy = tmp_path / "elsewhere" / "arm.urdf"
     copy.parent.mkdir()
     shutil.copy(ARM, copy)  # no package.xml above the copy: the walk-up finds nothing
-    with pytest.raises(SpecError, match="unknown package 'pkg_demo'"):
-        import_robot(copy, tmp_path / "none")
+    with pytest.raises(SpecError, match="unknown package 'pkg_demo'"):  # --strict: no drop
+        import_robot(copy, tmp_path / "none", strict=True)
     import_robot(copy, tmp_path / "dir", package_dirs=(URDF,))
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(URDF))
     assert import_robot(copy, tmp_path / "env").meshes == 1
@@ -144,7 +144,8 @@ def test_xacro_is_expanded(tmp_path):
     ],
 )
 def test_errors_are_one_line(tmp_path, name, message):
-    result = CliRunner().invoke(main, ["import", str(URDF / name), "--out", str(tmp_path)])
+    args = ["import", str(URDF / name), "--out", str(tmp_path), "--strict"]  # no mesh drop
+    result = CliRunner().invoke(main, args)
     assert result.exit_code == 2
     assert message in result.output and "Traceback" not in result.output
     assert len(result.output.strip().splitlines()) == 1

@@ -41,3 +41,38 @@ def test_publish_refuses_a_folder_that_is_not_a_publication(tmp_path):
     with pytest.raises(SimkitError, match="not an earlier publication"):
         publish(tmp_path, ["rosie_1000"])
     assert (tmp_path / "notes.txt").read_text() == "keep me"
+
+
+def _snapshot(site):
+    seen = {}
+    for path in [site, *sorted(site.rglob("*"))]:
+        st = path.lstat()
+        data = path.read_bytes() if path.is_file() else None
+        seen[path.relative_to(site).as_posix()] = (data, st.st_ino, st.st_mtime_ns)
+    return seen
+
+
+@pytest.mark.slow
+def test_republishing_rewrites_only_what_changed(tmp_path):
+    """The site folder (rsynced to the server) follows the build folder's rules: publishing
+    the same kits again changes no byte, name or mtime; after a change, the files whose bytes
+    did not change keep their inode and mtime, and nothing hidden is left beside the site."""
+    from pathlib import Path
+
+    spec = tmp_path / "planar_2r.yaml"
+    source = Path(__file__).resolve().parent / "specs" / "planar_2r.yaml"
+    spec.write_text(source.read_text())
+    site = tmp_path / "out" / "sim"
+    publish(site, [str(spec)])
+    before = _snapshot(site)
+    publish(site, [str(spec)])
+    assert _snapshot(site) == before
+    spec.write_text(source.read_text().replace("title: Planar 2R", "title: Planar 2R arm"))
+    publish(site, [str(spec)])
+    after = _snapshot(site)
+    changed = sorted(p for p in before if p in after and after[p][0] != before[p][0])
+    assert "index.json" in changed and any(p.endswith("robot.json") for p in changed)
+    kept = [p for p in before if before[p][0] is not None and p not in changed]
+    assert any(p.endswith(".stl") for p in kept)
+    assert all(after[p][1:] == before[p][1:] for p in kept)
+    assert sorted(p.name for p in site.parent.iterdir()) == ["sim"]

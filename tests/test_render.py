@@ -22,8 +22,16 @@ from simkit.kitio.resources import robot_names
 from simkit.pipeline import build
 from simkit.review.diff_html import HIGHLIGHT, diff_image
 from simkit.review.png import png_bytes, read_png
-from simkit.review.render import NO_GL_HINT, gl_backend, render_kit
-from simkit.review.scene import Camera, fit_camera, parse_camera, parse_size, scene_xml
+from simkit.review.render import NO_GL_HINT, Item, gl_backend, render_kit, run_job
+from simkit.review.render_worker import clean_shadows
+from simkit.review.scene import (
+    Camera,
+    fit_camera,
+    framing_points,
+    parse_camera,
+    parse_size,
+    scene_xml,
+)
 
 SPECS = Path(__file__).resolve().parent / "specs"
 SIZE = (320, 240)
@@ -40,9 +48,11 @@ def gl() -> str:
 
 
 def _robot_pixels(image: np.ndarray) -> int:
-    """Pixels far from the grey-white floor and sky: the robot (and its shadow)."""
-    spread = image.astype(int).max(axis=2) - image.astype(int).min(axis=2)
-    return int(((spread > 40) | (image.max(axis=2) < 150)).sum())
+    """Pixels far from the dark blue-grey floor and sky: the robot (white, grey or coloured).
+    The backdrop is darker than 130 and bluer than it is red."""
+    rgb = image.astype(int)
+    backdrop = (rgb.max(axis=2) < 130) & (rgb[..., 2] - rgb[..., 0] > 8)
+    return int((~backdrop).sum())
 
 
 # ---- fast: pure functions ----------------------------------------------------------------
@@ -88,6 +98,85 @@ def test_scene_xml_replaces_lights_and_adds_floor():
     assert 'meshdir="/abs/meshes"' in xml
     assert xml.count("<light") == 2 and "simkit_render_key" in xml and "simkit_render_fill" in xml
     assert 'name="simkit_render_floor" type="plane"' in xml
+
+
+def test_framing_keeps_fixtures_only_near_the_moving_links():
+    arm = np.array([[0.0, 0.0, 0.5], [0.3, 0.1, 0.8]])
+    plate = np.array([[-0.5, -0.05, 0.0], [0.5, 0.05, 1.0], [0.1, 0.0, 0.6], [0.32, 0.1, 0.5]])
+    points = framing_points(np.concatenate([arm, plate]), np.array([1, 1, 0, 0, 0, 0], bool))
+    # the plate's far corners go, its points beside the arm (within 10 % of 0.3 m) stay
+    assert points.tolist() == [*arm.tolist(), plate[2].tolist(), plate[3].tolist()]
+    alone = framing_points(plate, np.zeros(4, bool))  # no moving links: everything counts
+    assert (alone == plate).all()
+
+
+def _luminance(rgb) -> float:
+    """WCAG relative luminance of an sRGB colour (0..1 channels)."""
+    c = np.asarray(rgb, float)[:3]
+    lin = np.where(c <= 0.03928, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return float(lin @ (0.2126, 0.7152, 0.0722))
+
+
+def test_floor_and_backdrop_contrast_with_every_light_robot_material():
+    """Issue 25: a white robot on a light floor had low contrast. Every light material of the
+    five robots (luminance above 0.3) stands out from the floor's and the sky's colours by a
+    WCAG contrast ratio of at least 3."""
+    import xml.etree.ElementTree as ET
+
+    from simkit.pipeline import model_from_spec
+    from simkit.review.scene import SCENE_ASSETS
+
+    assets = ET.fromstring(SCENE_ASSETS)
+    backdrop = [
+        [float(v) for v in texture.get(key).split()]
+        for texture in assets.iter("texture")
+        for key in ("rgb1", "rgb2", "markrgb")
+        if texture.get(key)
+    ]
+    light = [
+        (name, rgba)
+        for robot in robot_names()
+        for name, rgba in model_from_spec(robot).materials
+        if _luminance(rgba) > 0.3 and rgba[3] == 1
+    ]
+    assert len(light) >= 3  # white shells, light greys, turquoise
+    for name, rgba in light:
+        for colour in backdrop:
+            dark, bright = sorted((_luminance(colour), _luminance(rgba)))
+            assert (bright + 0.05) / (dark + 0.05) >= 3, (name, colour)
+
+
+def test_shadow_box_covers_the_robot_and_the_floor_in_view():
+    from simkit.review.scene import shadow_clip
+
+    points = np.array([[0.0, 0.0, 0.0], [0.2, 0.1, 0.9]])
+    light = np.array([-0.4, 0.4, -0.82])
+    centre = points.mean(axis=0)
+    near = fit_camera(Camera(135.0, -20.0), points, 45.0, 4 / 3)
+    far = Camera(135.0, -20.0, 3 * near.distance, near.lookat)
+    clip = shadow_clip(near, 45.0, 4 / 3, points, 0.0, centre, light)
+    d = points - centre
+    across = d - np.outer(d @ light, light) / (light @ light)
+    assert clip >= np.linalg.norm(across, axis=1).max()  # the robot
+    assert shadow_clip(far, 45.0, 4 / 3, points, 0.0, centre, light) > 2 * clip  # more floor
+    up = Camera(135.0, 30.0, near.distance, near.lookat)  # looking up: no floor at the bottom
+    assert shadow_clip(up, 45.0, 4 / 3, points, 0.0, centre, light) == pytest.approx(
+        np.linalg.norm(across, axis=1).max()
+    )
+
+
+def test_clean_shadows_removes_speckle_and_keeps_shadows():
+    plain = np.full((40, 40, 3), 120, dtype=np.uint8)
+    shadowed = plain.copy()
+    shadowed[10:30, 5:25] = 60  # a real shadow: a region
+    rng = np.random.default_rng(3)
+    speckle = rng.random((40, 40)) < 0.08  # acne: isolated dark pixels
+    shadowed[speckle] = 20
+    out = clean_shadows(shadowed, plain)
+    assert (out[13:27, 8:22] < 70).all()  # the shadow stays, inside and up to near its edge
+    outside = np.ones((40, 40), bool)
+    outside[8:32, 3:27] = False
+    assert (out[outside] == 120).all()  # every speckle outside it is gone
 
 
 def test_diff_image_marks_exactly_the_changed_pixels():
@@ -218,14 +307,11 @@ def test_diff_html_gets_a_collision_row_when_collision_pieces_change(rosie_1000,
     old = rosie_1000.kit_dir
     new = tmp_path / "new"
     shutil.copytree(old, new)
-    piece = new / "meshes/collision/link_2_00.stl"
-    stl = bytearray(piece.read_bytes())
-    count = int.from_bytes(stl[80:84], "little")
-    floats = np.frombuffer(bytes(stl[84:]), dtype=np.uint8).reshape(count, 50)
-    verts = floats[:, 12:48].copy().view("<f4").reshape(count, 3, 3) * np.float32(1.3)
-    rows = floats.copy()
-    rows[:, 12:48] = verts.astype("<f4").view(np.uint8).reshape(count, 36)
-    piece.write_bytes(bytes(stl[:84]) + rows.tobytes())
+    from simkit.kitio.obj import from_obj, to_obj
+
+    piece = new / "meshes/collision/link_2_00.obj"
+    mesh = from_obj(piece.read_bytes())
+    piece.write_bytes(to_obj(mesh._replace(vertices=mesh.vertices * 1.3), "link_2_00"))
     report = tmp_path / "report.html"
     result = CliRunner().invoke(main, ["diff", str(old), str(new), "--html", str(report)])
     assert result.exit_code == 1, result.output
@@ -250,3 +336,95 @@ def test_without_opengl_one_line_names_the_package(rosie_1000, tmp_path, monkeyp
     assert result.output == f"simkit: error: {NO_GL_HINT}\n"
     assert "libosmesa6" in NO_GL_HINT
     assert not out.exists() and list(tmp_path.iterdir()) == []  # nothing half-written
+
+
+# ---- issue 25: framing, floor speckle, contrast (all five kits) ---------------------------
+
+
+def _basis(camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    az, el = np.radians(camera.azimuth), np.radians(camera.elevation)
+    forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    right = np.cross(forward, (0, 0, 1))
+    right /= np.linalg.norm(right)
+    return forward, right, np.cross(right, forward)
+
+
+def _project(camera: Camera, points: np.ndarray, aspect: float) -> np.ndarray:
+    """(N, 2) image coordinates in [-1, 1] (x right, y up) of world points, pinhole camera
+    with MuJoCo's 45 degree vertical field of view."""
+    forward, right, up = _basis(camera)
+    v = points - (np.asarray(camera.lookat) - camera.distance * forward)
+    depth = v @ forward
+    assert (depth > 0).all()
+    tan_v = np.tan(np.radians(22.5))
+    return np.column_stack([(v @ right) / depth / (tan_v * aspect), (v @ up) / depth / tan_v])
+
+
+def _floor_mask(camera: Camera, size, floor_z: float, robot_box) -> np.ndarray:
+    """Pixels that see the floor within four camera distances, outside the robot's box."""
+    w, h = size
+    forward, right, up = _basis(camera)
+    eye = np.asarray(camera.lookat) - camera.distance * forward
+    tan_v = np.tan(np.radians(22.5))
+    x = (2 * (np.arange(w) + 0.5) / w - 1)[None, :, None]
+    y = (1 - 2 * (np.arange(h) + 0.5) / h)[:, None, None]
+    rays = forward + x * tan_v * w / h * right + y * tan_v * up
+    t = (floor_z - eye[2]) / np.where(rays[..., 2] < 0, rays[..., 2], -1e-9)
+    hits = (rays[..., 2] < 0) & (np.linalg.norm(rays * t[..., None], axis=2) < 4 * camera.distance)
+    (x0, y0), (x1, y1) = robot_box
+    cols = (np.arange(w) + 0.5) / w * 2 - 1
+    rows = 1 - (np.arange(h) + 0.5) / h * 2
+    pad = 16 / h
+    inside = ((rows[:, None] > y0 - pad) & (rows[:, None] < y1 + pad)) & (
+        (cols[None, :] > x0 - pad) & (cols[None, :] < x1 + pad)
+    )
+    return hits & ~inside
+
+
+def _speckle(image: np.ndarray, mask: np.ndarray) -> float:
+    """High-frequency energy: the share of masked pixels more than 20 grey levels from the
+    median of their 3x3 neighbourhood (isolated dots; the checker's edges are softer)."""
+    from scipy.ndimage import median_filter
+
+    grey = image.astype(float).mean(axis=2)
+    return float((np.abs(grey - median_filter(grey, size=3)) > 20)[mask].mean())
+
+
+@pytest.mark.slow
+def test_robot_fills_the_frame_and_the_floor_is_clean_for_every_kit(kit_factory, gl, tmp_path):
+    import mujoco
+
+    from simkit.diff import load_kit
+    from simkit.review.scene import load_scene, posed_points
+
+    size = (640, 480)
+    aspect = size[0] / size[1]
+    speckle: dict[str, float] = {}
+    for name in robot_names():
+        kit = kit_factory(name).kit_dir
+        poses = list(json.loads((kit / "robot.json").read_text())["poses"])
+        items = [Item(0, pose, False, tmp_path / f"{name}_{pose}.png") for pose in poses]
+        cameras = run_job([kit], items, size)["cameras"]
+        (tmp_path / name).mkdir()
+        scene = load_scene(load_kit(kit), tmp_path / name, name)
+        data = mujoco.MjData(scene.model)
+        floor_z = min(0.0, float(posed_points(scene, data)[0][:, 2].min()))
+        scores = []
+        for item in items:
+            points, moving = posed_points(scene, data, [item.pose])
+            xy = _project(cameras[item.pose], points[moving], aspect)
+            lo, hi = xy.min(axis=0), xy.max(axis=0)
+            where = f"{name} {item.pose}"
+            assert (lo >= -1).all() and (hi <= 1).all(), f"{where}: the robot leaves the frame"
+            assert ((hi - lo) / 2).max() >= 0.6, f"{where}: the robot spans {(hi - lo) / 2}"
+            everything = _project(cameras[item.pose], points, aspect)
+            box = (everything.min(axis=0), everything.max(axis=0))
+            mask = _floor_mask(cameras[item.pose], size, floor_z, box)
+            assert mask.mean() > 0.05, f"{where}: too little floor to measure"
+            image = read_png(item.file)
+            scores.append(_speckle(image, mask))
+            # contrast: the robot's pixels differ from the backdrop's
+            assert _robot_pixels(image) > 0.05 * mask.size, f"{where}: the robot is hard to see"
+        speckle[name] = max(scores)
+    cleanest = max(min(speckle.values()), 1e-4)
+    assert max(speckle.values()) <= 2 * cleanest, speckle

@@ -36,7 +36,7 @@ def test_rounded_is_what_num_prints(x):
 def test_layout_paths_are_relative_posix():
     assert layout.kit_dir_name("rosie_1000") == "rosie_1000_description"
     assert layout.zip_name("rosie_1000") == "rosie-1000-sim-kit.zip"
-    assert layout.collision_mesh("link_3", 2) == "meshes/collision/link_3_02.stl"
+    assert layout.collision_mesh("link_3", 2) == "meshes/collision/link_3_02.obj"
     assert layout.relative("urdf/x.urdf", "meshes") == "../meshes"
     for path in (layout.urdf("r"), layout.mjcf("r"), layout.usd("r"), layout.glb("r")):
         assert not path.startswith("/") and ".." not in path and "\\" not in path

@@ -79,7 +79,8 @@ def test_stage_layout(rosie_1000):
     # kp = effort_peak / 0.01 rad = 33000 N m/rad -> per degree
     assert drive.GetStiffnessAttr().Get() == pytest.approx(33000 * np.pi / 180, rel=1e-6)
     visual = UsdGeom.Mesh(stage.GetPrimAtPath("/rosie_1000/link_2/visuals/link_2"))
-    assert len(visual.GetNormalsAttr().Get()) == len(visual.GetFaceVertexIndicesAttr().Get())
+    normals = UsdGeom.PrimvarsAPI(visual).GetPrimvar("normals").Get()  # issue 25: a primvar
+    assert len(normals) == len(visual.GetFaceVertexIndicesAttr().Get())
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
     text = (rosie_1000.kit_dir / USDA).read_text(encoding="utf-8")
@@ -259,3 +260,42 @@ def test_orient_keeps_small_turns_as_usd_reads_them(angle):
     _place(prim, (0.1, 0.0, 0.0), rot)
     world = np.array(UsdGeom.XformCache().GetLocalToWorldTransform(prim)).T
     assert np.abs(world[:3, :3] - rot).max() < 1e-8
+
+
+def test_visual_normals_are_face_varying_primvars_equal_to_the_glb_normals():
+    """Issue 25: the USD shades like the GLB: the same corner normals, smooth on curved
+    surfaces and sharp at creases (kitio/normals.py)."""
+    from pxr import Sdf, Usd, UsdGeom
+
+    from simkit.check.readers.glb import read_glb
+    from simkit.emit import glb
+
+    robot = model_from_spec("rosie_1000")
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.ImportFromString(usd.stage_text(robot))
+    stage = Usd.Stage.Open(layer)
+    ((_path, data),) = glb.emit(robot).items()
+    doc, binary = read_glb(data)
+
+    def accessor(index: int, dtype: str, width: int) -> np.ndarray:
+        acc = doc["accessors"][index]
+        view = doc["bufferViews"][acc["bufferView"]]
+        flat = np.frombuffer(binary, dtype, acc["count"] * width, view["byteOffset"])
+        return flat.reshape(-1, width)
+
+    checked = 0
+    for mesh in doc["meshes"]:
+        prim = stage.GetPrimAtPath(f"/rosie_1000/{mesh['name']}/visuals/{mesh['name']}")
+        primvar = UsdGeom.PrimvarsAPI(prim).GetPrimvar("normals")
+        assert primvar.GetInterpolation() == UsdGeom.Tokens.faceVarying
+        normals = np.array(primvar.Get()).reshape(-1, 3, 3)
+        attrs = mesh["primitives"][0]["attributes"]
+        triangles = accessor(mesh["primitives"][0]["indices"], "<u2", 1).reshape(-1, 3)
+        from_glb = accessor(attrs["NORMAL"], "<f4", 3)[triangles]
+        assert normals.shape == from_glb.shape
+        np.testing.assert_allclose(normals, from_glb, atol=1e-6)
+        # curved faces shade smoothly (a triangle's corners differ), planar ones flat
+        spread = np.abs(normals - normals[:, :1]).max(axis=(1, 2))
+        assert (spread > 0.01).any() and (spread == 0).any()
+        checked += 1
+    assert checked == sum(link.solid is not None for link in robot.links)

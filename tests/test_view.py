@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from simkit.errors import SimkitError
-from simkit.review.view import WEB, start_server
+from simkit.kitio.resources import robot_names
+from simkit.review.view import WEB, serve_kit, start_server
 
 CHROMIUM = os.environ.get("SIMKIT_CHROMIUM") or shutil.which("chromium")
 FLAGS = [
@@ -66,6 +67,57 @@ def test_server_serves_page_vendored_three_and_kit_files_only(small_kit):
     finally:
         server.shutdown()
         server.server_close()
+
+
+def _raw(port: int, target: str) -> bytes:
+    """The status line of a raw GET (urllib would re-quote or refuse odd targets)."""
+    import socket
+
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as conn:
+        conn.sendall(f"GET {target} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n".encode())
+        data = b""
+        while chunk := conn.recv(65536):
+            data += chunk
+    return data.split(b"\r\n", 1)[0]
+
+
+def test_nul_bytes_and_long_urls_get_400_or_404_not_a_traceback(small_kit, capfd):
+    """Issue 24: `%00` and a 10,000-character URL dropped the connection with a traceback."""
+    server = start_server(small_kit, 0)
+    port = server.server_address[1]
+    try:
+        assert _raw(port, "/kit/%00") == b"HTTP/1.0 400 control character in URL"
+        assert _raw(port, "/kit/robot.json%00.png").startswith(b"HTTP/1.0 400")
+        assert _raw(port, "/%0a").startswith(b"HTTP/1.0 400")
+        assert _raw(port, "/kit/" + "a" * 10_000).startswith(b"HTTP/1.0 404")
+        assert _raw(port, "/kit/" + "a/" * 4_000).startswith(b"HTTP/1.0 404")
+        assert _raw(port, "/" + "b" * 300).startswith(b"HTTP/1.0 404")  # one name > 255 bytes
+        assert _raw(port, "/kit/robot.json").startswith(b"HTTP/1.0 200")  # still serving
+    finally:
+        server.shutdown()
+        server.server_close()
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "Error" not in err, err
+
+
+def test_zip_with_a_file_and_a_folder_of_one_name_is_one_line(tmp_path):
+    """Issue 24: `simkit view` crashed on a zip holding `meshes` and `meshes/part.stl`."""
+    import zipfile
+
+    from click.testing import CliRunner
+
+    from simkit.cli import main
+
+    bad = tmp_path / "clash.zip"
+    with zipfile.ZipFile(bad, "w") as archive:
+        archive.writestr("kit/robot.json", '{"name": "tiny", "joints": []}')
+        archive.writestr("kit/meshes", b"a file")
+        archive.writestr("kit/meshes/part.stl", b"solid x\nendsolid x\n")
+    with pytest.raises(SimkitError, match="'meshes' is both a file and a folder"):
+        serve_kit(bad, 0, open_browser=False)
+    result = CliRunner().invoke(main, ["view", str(bad), "--no-browser", "--port", "0"])
+    assert result.exit_code == 2 and result.output.count("\n") == 1, result.output
+    assert "both a file and a folder" in result.output
 
 
 def test_page_and_vendored_files_reference_nothing_outside():
@@ -154,6 +206,11 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
                 value,
             )
             seen_after = np.array(page.evaluate(f"simkitViewer.framePosition('{tool}')"))
+            boxes = {}  # issue 25: the camera frames the whole robot in every named pose
+            for pose in doc["poses"]:
+                page.click(f'button[data-pose="{pose}"]')
+                boxes[pose] = page.evaluate("simkitViewer.screenBox()")
+                (tmp_path / f"pose_{pose}.png").write_bytes(page.screenshot())
             page.click('input[data-collision="*"]')
             shot = page.screenshot()
             browser.close()
@@ -161,6 +218,10 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
         server.shutdown()
         server.server_close()
     assert problems == []
+    for pose, box in boxes.items():
+        lo, hi = np.array(box["lo"]), np.array(box["hi"])
+        assert (lo >= -1).all() and (hi <= 1).all(), f"{pose}: the robot leaves the canvas"
+        assert ((hi - lo) / 2).max() > 0.3, f"{pose}: the robot is a speck"
     moved = np.linalg.norm(seen_after - seen_before)
     assert moved == pytest.approx(np.linalg.norm(after - before), abs=1e-3)
     assert moved > 0.05  # a real move, not a no-op
@@ -169,3 +230,55 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
     view = image[:, 320:]  # right of the side panel: the 3D view
     assert view.std() > 10 and len(np.unique(view.reshape(-1, 3), axis=0)) > 200
     (tmp_path / "viewer.png").write_bytes(shot)
+
+
+@pytest.mark.parametrize("name", ["../evil.txt", "/abs/evil.txt", "kit/../../evil.txt"])
+def test_zip_entries_outside_the_kit_are_refused(tmp_path, name):
+    import zipfile
+
+    bad = tmp_path / "sub" / "escape.zip"
+    bad.parent.mkdir()
+    with zipfile.ZipFile(bad, "w") as archive:
+        archive.writestr("kit/robot.json", '{"name": "tiny", "joints": []}')
+        archive.writestr(name, b"outside")
+    with pytest.raises(SimkitError) as info:
+        serve_kit(bad, 0, open_browser=False)
+    assert "\n" not in str(info.value)
+    assert not list(tmp_path.rglob("evil.txt"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", robot_names())
+def test_viewer_frames_the_whole_robot_in_every_pose(kit_factory, name, tmp_path):
+    """Issue 25: the camera is fitted to every named pose, not home alone (the flange of
+    rosie_1000 left the canvas in "stretched")."""
+    if CHROMIUM is None:
+        if os.environ.get("SIMKIT_REQUIRE_RENDER"):
+            pytest.fail("no chromium on PATH (Debian: apt-get install chromium)")
+        pytest.skip("no chromium on PATH (Debian: apt-get install chromium)")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
+    kit = kit_factory(name).kit_dir
+    poses = json.loads((kit / "robot.json").read_text())["poses"]
+    server = start_server(kit, 0)
+    boxes = {}
+    try:
+        with sync_api.sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, args=FLAGS)
+            page = browser.new_page(viewport={"width": 900, "height": 600})
+            page.goto(f"http://127.0.0.1:{server.server_address[1]}/")
+            page.wait_for_function(
+                "window.simkitViewer.ready || window.simkitViewer.error", timeout=120_000
+            )
+            assert page.evaluate("window.simkitViewer.error") is None
+            for pose in poses:
+                page.click(f'button[data-pose="{pose}"]')
+                boxes[pose] = page.evaluate("simkitViewer.screenBox()")
+                (tmp_path / f"{pose}.png").write_bytes(page.screenshot())
+            browser.close()
+    finally:
+        server.shutdown()
+        server.server_close()
+    for pose, box in boxes.items():
+        lo, hi = np.array(box["lo"]), np.array(box["hi"])
+        assert (lo >= -1).all() and (hi <= 1).all(), f"{name} {pose}: leaves the canvas {box}"
+        assert ((hi - lo) / 2).max() > 0.3, f"{name} {pose}: the robot is a speck {box}"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 from rich.console import Console
@@ -11,8 +12,12 @@ from rich.console import Console
 from simkit import __version__
 from simkit.errors import SimkitError
 
+if TYPE_CHECKING:
+    from simkit.kitio.cache import Cache
+
 err = Console(stderr=True, highlight=False, soft_wrap=True)
 out = Console(highlight=False, soft_wrap=True)
+RAY_HELP = "One Ray task per robot ($RAY_ADDRESS, else a local Ray); needs simkit[ray]."
 
 
 def _fail(exc: SimkitError) -> None:
@@ -47,11 +52,23 @@ def main() -> None:
 )
 @click.option(
     "--cache-dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=click.Path(file_okay=False),  # kept as typed: a URL here is refused (cache.py)
     default=None,
     help="Cache folder. [default: $SIMKIT_CACHE_DIR, else the user cache folder]",
 )
 @click.option("--no-cache", is_flag=True, help="Compute every step; read and write no cache.")
+@click.option(
+    "--cache-readonly",
+    is_flag=True,
+    envvar="SIMKIT_CACHE_READONLY",
+    help="Read the caches, never write them (untrusted runners, e.g. fork pull requests).",
+)
+@click.option(
+    "--remote-cache",
+    default=None,
+    envvar="SIMKIT_REMOTE_CACHE",
+    help="Shared cache behind the local one, an fsspec URL such as s3://bucket/prefix.",
+)
 @click.option(
     "--usd-format",
     type=click.Choice(["usda", "usdc"]),
@@ -64,62 +81,149 @@ def main() -> None:
     is_flag=True,
     help="Leave out step/NAME.step (the STEP assembly; saves the Open CASCADE time).",
 )
+@click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
 def build(
     targets: tuple[str, ...],
     out_dir: Path,
     no_check: bool,
     quiet: bool,
     jobs: int | None,
-    cache_dir: Path | None,
+    cache_dir: str | None,
     no_cache: bool,
+    cache_readonly: bool,
+    remote_cache: str | None,
     usd_format: str,
     no_step: bool,
+    on_ray: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
-    from simkit.kitio.cache import Cache
+    if on_ray:
+        options = {"check": not no_check, "usd_format": usd_format, "step": not no_step}
+        # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)
+        options["cache_args"] = {
+            "root": cache_dir,
+            "enabled": not no_cache,
+            "readonly": cache_readonly or None,
+            "remote": remote_cache,
+        }
+        _build_on_ray(targets, out_dir, quiet, options)
+        return
+    cache = None
+    for target in targets:
+        if not no_cache:  # a rebuild with nothing changed: one line, no heavy import
+            from simkit.kitio import noop
+
+            options = noop.options(usd_format, not no_step, not no_check)
+            line = noop.unchanged(target, out_dir, cache_dir, options)
+            if line:
+                out.print(line, markup=False)
+                continue
+        if cache is None:
+            cache = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
+        _build_one(target, out_dir, not no_check, quiet, jobs, cache, usd_format, not no_step)
+
+
+def _build_one(
+    target: str,
+    out_dir: Path,
+    check: bool,
+    quiet: bool,
+    jobs: int | None,
+    cache: Cache,
+    usd_format: str,
+    step: bool,
+) -> None:
+    """The full build of one target (`simkit build`), and its summary line."""
+    import os
+
+    from simkit.kitio.cache import Stats
     from simkit.pipeline import build as run_build
 
-    cache = Cache.disabled() if no_cache else Cache.at(cache_dir)
+    # a build renders nothing: MuJoCo then skips its OpenGL (glfw, cffi) imports
+    os.environ.setdefault("MUJOCO_GL", "disable")
+    cache.stats = Stats()  # each summary line counts its own robot's hits
 
-    for target in targets:
+    def progress(msg: str) -> None:
+        if not quiet:
+            err.print(f"[{target}] {msg}", markup=False)
 
-        def progress(msg: str, _t: str = target) -> None:
-            if not quiet:
-                err.print(f"[{_t}] {msg}", markup=False)
-
-        try:
-            result = run_build(
-                target,
-                out_dir,
-                check=not no_check,
-                progress=None if quiet else progress,
-                cache=cache,
-                jobs=jobs,
-                usd_format=usd_format,
-                step=not no_step,
-            )
-        except SimkitError as exc:
-            _fail(exc)
-        passed = sum(f.ok for f in result.findings)
-        out.print(
-            f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
-            f"{result.zip_path}; {passed}/{len(result.findings)} checks passed",
-            markup=False,
+    try:
+        result = run_build(
+            target,
+            out_dir,
+            check=check,
+            progress=None if quiet else progress,
+            cache=cache,
+            jobs=jobs,
+            usd_format=usd_format,
+            step=step,
         )
+    except SimkitError as exc:
+        _fail(exc)
+    for warning in result.warnings if not quiet else ():
+        err.print(f"warning: {warning}", markup=False)
+    hits = f"; cache local/remote/miss: {cache.stats.summary()}" if cache.enabled else ""
+    out.print(_built_line(result) + hits, markup=False)
+
+
+def _built_line(result) -> str:
+    passed = sum(f.ok for f in result.findings)
+    same = "" if result.changed else " (the same bytes as before: nothing rewritten)"
+    return (
+        f"{result.robot}: {len(result.files)} files in {result.kit_dir}, zip "
+        f"{result.zip_path}{same}; {passed}/{len(result.findings)} checks passed"
+    )
+
+
+def _build_on_ray(targets: tuple[str, ...], out_dir: Path, quiet: bool, options: dict) -> None:
+    """`simkit build --ray`: one Ray task per target, published here (simkit/cluster.py)."""
+    from simkit.cluster import build_on_ray
+
+    try:
+        results = build_on_ray(targets, out_dir, None if quiet else _say, **options)
+    except SimkitError as exc:
+        _fail(exc)
+        return
+    for result in results:
+        for warning in result.warnings if not quiet else ():
+            err.print(f"warning: {warning}", markup=False)
+        hits = f"; cache local/remote/miss: {result.cache_hits}" if result.cache_hits else ""
+        out.print(_built_line(result) + hits, markup=False)
+
+
+def _open_cache(dir_: str | None, off: bool, readonly: bool, remote: str | None) -> Cache:
+    """The build's cache from the command line (a URL as --cache-dir: one-line error)."""
+    from simkit.kitio.cache import Cache
+
+    if off:
+        return Cache.disabled()
+    try:
+        return Cache.at(dir_, readonly=readonly, remote=remote)
+    except SimkitError as exc:
+        _fail(exc)
 
 
 @main.command()
 @click.argument("kit_dir", type=click.Path(path_type=Path))
 @click.option("-v", "--verbose", is_flag=True, help="Print every finding, not only failures.")
 def check(kit_dir: Path, verbose: bool) -> None:
-    """Run the checks on a built kit folder."""
+    """Run the checks on a built kit (folder or zip)."""
+    import tempfile
+
     from simkit.check import run_checks
+    from simkit.diff import load_kit, unpacked
     from simkit.errors import CheckFailed
 
     try:
-        if not kit_dir.is_dir():
-            raise SimkitError(f"{kit_dir}: no such kit folder")
-        findings = run_checks(kit_dir)
+        if kit_dir.is_dir():
+            _published_together(kit_dir)
+            findings = run_checks(kit_dir)
+        elif kit_dir.is_file():  # a zip: read with kitread's caps, written as plain files
+            files = load_kit(kit_dir)
+            with tempfile.TemporaryDirectory(prefix="simkit-check-") as tmp:
+                findings = run_checks(unpacked(kit_dir, files, Path(tmp)))
+        else:
+            raise SimkitError(f"{kit_dir}: no such kit folder or zip")
     except SimkitError as exc:
         _fail(exc)
     failed = [f for f in findings if not f.ok]
@@ -129,6 +233,17 @@ def check(kit_dir: Path, verbose: bool) -> None:
     out.print(f"{len(findings) - len(failed)} passed, {len(failed)} failed", markup=False)
     if failed:
         sys.exit(CheckFailed.exit_code)
+
+
+def _published_together(kit_dir: Path) -> None:
+    """A kit in a build folder: its zip and the manifest beside them agree (kitio/atomic.py),
+    else one line. Reads only."""
+    from simkit.errors import CheckFailed
+    from simkit.kitio.manifest import mismatch
+
+    line = mismatch(kit_dir)
+    if line:
+        raise CheckFailed(line)
 
 
 @main.command(name="list")
@@ -151,9 +266,18 @@ def list_robots() -> None:
     default=None,
     help="Also write a self-contained HTML report with renders of every named pose.",
 )
-def diff(old: Path, new: Path, as_json: bool, html_out: Path | None) -> None:
-    """Report what changed between two kits (folders or zips); exit 0 equal, 1 different."""
-    from simkit.diff import diff_kits, to_markdown
+@click.option(
+    "--markdown",
+    "md_out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Also write a short Markdown summary (GitHub job summary, PR comment); appends.",
+)
+def diff(old: Path, new: Path, as_json: bool, html_out: Path | None, md_out: Path | None) -> None:
+    """Report what changed between two kits (folders or zips) beyond the checks' tolerances;
+    exit 0 equal, 1 different."""
+    from simkit.diff import diff_kits
+    from simkit.diff_text import to_markdown, to_short_markdown
 
     try:
         report = diff_kits(old, new)
@@ -161,10 +285,26 @@ def diff(old: Path, new: Path, as_json: bool, html_out: Path | None) -> None:
             from simkit.review.commands import diff_html
 
             diff_html(report, old, new, html_out, _say)
+        if md_out is not None:
+            full = (
+                f"Full report with renders: `{html_out}`."
+                if html_out is not None
+                else "Full report: `simkit diff OLD NEW --html REPORT.html`."
+            )
+            _append(md_out, to_short_markdown(report, full))
     except SimkitError as exc:
         _fail(exc)
     click.echo(report.to_json() if as_json else to_markdown(report), nl=False)
     sys.exit(0 if report.equal else 1)
+
+
+def _append(path: Path, text: str) -> None:
+    """Append `text` to `path` (GitHub's job summary file is shared by the job's steps)."""
+    try:
+        with open(path, "a", encoding="utf-8") as handle:
+            handle.write(text)
+    except OSError as exc:
+        raise SimkitError(f"{path}: cannot write ({exc.strerror or exc})") from None
 
 
 def _say(msg: str) -> None:
@@ -227,17 +367,35 @@ def view(kit: Path, port: int, no_browser: bool) -> None:
     help="The site's /assets/sim/ folder (replaced as a whole).",
 )
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
-def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
+@click.option("--cache-dir", type=click.Path(file_okay=False), default=None, help="As build's.")
+@click.option("--cache-readonly", is_flag=True, envvar="SIMKIT_CACHE_READONLY", help="As build's.")
+@click.option("--remote-cache", default=None, envvar="SIMKIT_REMOTE_CACHE", help="As build's.")
+@click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
+def publish(
+    robots: tuple[str, ...],
+    out_dir: Path,
+    quiet: bool,
+    cache_dir: str | None,
+    cache_readonly: bool,
+    remote_cache: str | None,
+    on_ray: bool,
+) -> None:
     """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and
     index.json, as the download site serves them under /assets/sim/."""
     from simkit.publish import publish as run_publish
+
+    if on_ray:  # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)
+        args = {"root": cache_dir, "readonly": cache_readonly or None, "remote": remote_cache}
+        options = {"on_ray": True, "cache_args": args}
+    else:
+        options = {"cache": _open_cache(cache_dir, False, cache_readonly, remote_cache)}
 
     def progress(msg: str) -> None:
         if not quiet:
             err.print(msg, markup=False)
 
     try:
-        index = run_publish(out_dir, robots or None, progress=progress)
+        index = run_publish(out_dir, robots or None, progress=progress, **options)
     except SimkitError as exc:
         _fail(exc)
     files = sum(len(kit["files"]) for kit in index["kits"])
@@ -275,6 +433,20 @@ def publish(robots: tuple[str, ...], out_dir: Path, quiet: bool) -> None:
 )
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path))
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
+@click.option(
+    "--xacro-arg", "xacro_args", multiple=True, help="NAME:=VALUE for $(arg NAME); repeatable."
+)
+@click.option(
+    "--allow-env", "allow_env", multiple=True, help="Env var $(env)/$(optenv) may read; repeatable."
+)
+@click.option(
+    "--allow-read",
+    "allow_read",
+    multiple=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder outside the robot's package that meshes and includes may read; repeatable.",
+)
+@click.option("--trust-xacro", is_flag=True, help="Run the xacro as is (trusted files only).")
 def import_urdf(
     path: Path,
     name: str | None,
@@ -286,14 +458,22 @@ def import_urdf(
     hull_collision: bool,
     out_dir: Path,
     quiet: bool,
+    xacro_args: tuple[str, ...],
+    allow_env: tuple[str, ...],
+    allow_read: tuple[Path, ...],
+    trust_xacro: bool,
 ) -> None:
     """Turn a URDF or xacro into OUT/NAME.yaml plus the meshes it needs."""
     from simkit.importer import import_robot
+    from simkit.importer.reading import ReadOptions, parse_xacro_arg
 
     if floating_base and fixed_base:
-        raise click.UsageError("--floating-base and --fixed-base exclude each other")
+        _fail(SimkitError("--floating-base and --fixed-base exclude each other"))
     floating = True if floating_base else False if fixed_base else None
     try:
+        reading = ReadOptions(
+            tuple(parse_xacro_arg(a) for a in xacro_args), allow_env, allow_read, trust_xacro
+        )
         done = import_robot(
             path,
             out_dir,
@@ -303,6 +483,7 @@ def import_urdf(
             floating=floating,
             hull_collision=hull_collision,
             density=density,
+            reading=reading,
         )
     except SimkitError as exc:
         _fail(exc)

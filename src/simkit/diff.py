@@ -1,11 +1,14 @@
 """`simkit diff OLD NEW`: what changed between two kits, for a pull request review.
 
 Compares two kit folders or zips: joints (limits, speeds, torques, drive, origin, axis),
-links (mass, CoM, inertia), links and joints added or removed (all from robot.json), meshes
-whose bytes changed (volume, bounding box, triangle count), each link's number of convex
-collision pieces, each STEP solid's volume and bounding box (diff_step.py), other robot.json
-keys that changed, and files added, removed or changed.
-Markdown for people, JSON for machines. Two kits are equal when every file is byte-identical.
+links (mass, CoM, inertia), links and joints added or removed (all from robot.json), each
+mesh as a placed piece in its link frame (displacement, rotation, shape, volume, bounding
+box: diff_mesh.py), each link's number of convex collision pieces, each STEP solid's volume
+and bounding box (diff_step.py), other robot.json values that changed, and files added,
+removed or changed. Every number is compared with the tolerance the checks use for its
+quantity (diff_tol.py): a difference below it is round-off, not a change. Two kits are
+equal when nothing changed beyond round-off; `identical` when every file is byte-identical.
+Markdown for people (diff_text.py), JSON for machines.
 """
 
 from __future__ import annotations
@@ -16,13 +19,11 @@ import re
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-import numpy as np
-
+from simkit.diff_mesh import glb_close, mesh_changes, usd_close
+from simkit.diff_tol import PARAM_SI, leaf_changes, same, text_close, tolerance
 from simkit.errors import SimkitError
 from simkit.kitio import layout
-from simkit.kitio.fmt import num
 from simkit.kitio.kitread import read_folder_safely, read_zip_safely, robot_json_problem
-from simkit.kitio.stl import from_stl
 
 #: robot.json joint fields compared, with their units (angles of prismatic joints are m).
 JOINT_FIELDS = {
@@ -48,8 +49,12 @@ JOINT_FIELDS = {
 LINK_FIELDS = {"mass": "kg", "com": "m", "inertia": "kg m^2"}
 #: robot.json keys the sections above cover (and `*_deg` twins, which follow the radians).
 COVERED_KEYS = {"joints", "fixed_joints", "links"}
-ANGLE_FIELDS = {"lower", "upper", "max_velocity", "origin_rpy", "springref"}
-COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.stl$")
+#: robot.json keys that say how the kit was made (spec digest, library versions), not what it
+#: is: listed apart, never a change of the kit
+METADATA_KEYS = ("provenance",)
+#: changed values listed per other robot.json key; the rest are counted
+MAX_LEAVES = 8
+COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.(?:stl|obj)$")
 
 
 @dataclass(frozen=True)
@@ -74,20 +79,48 @@ class Report:
     added: list[str] = field(default_factory=list)
     removed: list[str] = field(default_factory=list)
     changed: list[str] = field(default_factory=list)
+    #: files whose bytes differ only below the tolerances or in METADATA_KEYS
+    round_off: list[str] = field(default_factory=list)
+    #: METADATA_KEYS values that changed (paths such as provenance.spec_sha256)
+    metadata: list[str] = field(default_factory=list)
 
     @property
     def equal(self) -> bool:
+        """Nothing changed beyond round-off."""
         return not (self.changes or self.added or self.removed or self.changed)
 
+    @property
+    def identical(self) -> bool:
+        return self.equal and not self.round_off
+
     def to_json(self) -> str:
+        """The report as strict JSON (a NaN or infinity read from a kit becomes a string)."""
         doc = {
             "equal": self.equal,
+            "identical": self.identical,
             "old": self.old,
             "new": self.new,
             "changes": [asdict(c) for c in self.changes],
-            "files": {"added": self.added, "removed": self.removed, "changed": self.changed},
+            "files": {
+                "added": self.added,
+                "removed": self.removed,
+                "changed": self.changed,
+                "round_off": self.round_off,
+            },
+            "metadata": self.metadata,
         }
-        return json.dumps(doc, indent=2) + "\n"
+        return json.dumps(_finite(doc), indent=2, allow_nan=False) + "\n"
+
+
+def _finite(value):
+    """`value` with every non-finite float as the string JSON readers know it by."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "NaN" if math.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value
 
 
 def _read_zip(path: Path) -> dict[str, bytes]:
@@ -117,6 +150,34 @@ def load_kit(path: Path) -> dict[str, bytes]:
     return files
 
 
+def materialize(files: dict[str, bytes], dest: Path) -> Path:
+    """Write a kit read by `load_kit` (confined, plain files) under the empty folder `dest`,
+    for readers that need files on disk (`simkit check KIT.zip`). A path that is both a file
+    and a folder is refused in one line."""
+    for rel in sorted(files):
+        path = dest / rel
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with open(path, "xb") as handle:  # never through a link, never over a file
+                handle.write(files[rel])
+        except OSError as exc:
+            raise SimkitError(f"{rel}: cannot be extracted ({exc.strerror or exc})") from None
+    return dest
+
+
+def unpacked(zip_path: Path, files: dict[str, bytes], tmp: Path) -> Path:
+    """A kit zip as a build lays it out, under the empty folder `tmp`: the files under
+    `NAME_description/` and the zip itself beside them, so the checks that compare the two
+    run as on a build (`simkit check KIT.zip`). A robot name unfit for a folder name (any
+    character beyond [A-Za-z0-9_]) unpacks as `kit/`, without the zip."""
+    name = str(json.loads(files[layout.ROBOT_JSON]).get("name", ""))
+    if not re.fullmatch(r"[A-Za-z0-9_]{1,100}", name):
+        return materialize(files, tmp / "kit")
+    kit = materialize(files, tmp / layout.kit_dir_name(name))
+    (tmp / layout.zip_name(name)).write_bytes(zip_path.read_bytes())
+    return kit
+
+
 def _robot_json(files: dict[str, bytes]) -> dict:
     data = files.get(layout.ROBOT_JSON)
     return json.loads(data) if data else {}
@@ -138,35 +199,36 @@ def _entities(
     out = [Change(kind, name, "removed") for name in old if name not in new]
     out += [Change(kind, name, "added") for name in new if name not in old]
     for name in (n for n in new if n in old):
+        a, b = old[name], new[name]
         for key, unit in fields.items():
-            a, b = _flat(old[name].get(key)), _flat(new[name].get(key))
-            if a != b:
-                if old[name].get("type") == "prismatic" and key in ("lower", "upper"):
-                    unit = "m"
-                out.append(Change(kind, name, "modified", key, a, b, unit))
+            if a.get("type") == "prismatic" and key in ("lower", "upper"):
+                unit = "m"
+            x, y = _flat(a.get(key)), _flat(b.get(key))
+            if not same(x, y, tolerance(unit)):
+                out.append(Change(kind, name, "modified", key, x, y, unit))
+        out += _other_fields(kind, name, a, b, fields)
     return out
 
 
-def _mesh_stats(path: str, data: bytes) -> dict:
-    try:
-        mesh = from_stl(data)
-    except (ValueError, IndexError) as exc:
-        raise SimkitError(f"{path}: not a binary STL ({exc})") from None
-    tri = mesh.vertices[mesh.faces]
-    volume = float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6)
-    size = (mesh.vertices.max(axis=0) - mesh.vertices.min(axis=0)).tolist() if len(tri) else []
-    return {"volume": volume, "bbox": size, "triangles": len(mesh.faces)}
+def _other_fields(kind: str, name: str, a: dict, b: dict, fields: dict) -> list[Change]:
+    """Fields of a joint or link beyond `fields` (drive, derived values, estimates), each
+    changed value with its path; a `*_deg*` twin follows its radians and is skipped."""
+    keys = [k for k in [*a, *(k for k in b if k not in a)] if k not in fields and k != "name"]
+    keys = [k for k in keys if not ("_deg" in k and k.split("_deg")[0] in {*a, *b})]
+    leaves = [leaf for k in keys for leaf in leaf_changes(a.get(k), b.get(k), PARAM_SI, k)]
+    out = [Change(kind, name, "modified", path, x, y) for path, x, y in leaves[:MAX_LEAVES]]
+    if len(leaves) > MAX_LEAVES:
+        more = f"{len(leaves) - MAX_LEAVES} more values"
+        out.append(Change(kind, name, "modified", "...", "-", more))
+    return out
 
 
 def _meshes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
     out = []
     for path in sorted(set(old) & set(new)):
-        if not path.endswith(".stl") or old[path] == new[path]:
-            continue
-        a, b = _mesh_stats(path, old[path]), _mesh_stats(path, new[path])
-        for key, unit in (("volume", "m^3"), ("bbox", "m"), ("triangles", "")):
-            if a[key] != b[key]:
-                out.append(Change("mesh", path, "modified", key, a[key], b[key], unit))
+        if path.endswith((".stl", ".obj")) and old[path] != new[path]:
+            changes = mesh_changes(path, old[path], new[path])
+            out += [Change("mesh", path, "modified", *c) for c in changes]
     return out
 
 
@@ -179,6 +241,40 @@ def _pieces(files: dict[str, bytes]) -> dict[str, int]:
     return count
 
 
+def _other_entries(a: dict, b: dict) -> list[Change]:
+    """Other robot.json keys: each changed value (at most MAX_LEAVES per key) with its path."""
+    out = []
+    keys = [k for k in b if k in a] + [k for k in a if k not in b] + [k for k in b if k not in a]
+    for key in keys:
+        if key in COVERED_KEYS or key in METADATA_KEYS:
+            continue
+        if key not in a or key not in b:
+            out.append(Change("robot_json", key, "added" if key not in a else "removed"))
+            continue
+        leaves = list(leaf_changes(a[key], b[key], PARAM_SI))
+        for path, old, new in leaves[:MAX_LEAVES]:
+            out.append(Change("robot_json", key, "modified", path or key, old, new))
+        if len(leaves) > MAX_LEAVES:
+            more = f"{len(leaves) - MAX_LEAVES} more values"
+            out.append(Change("robot_json", key, "modified", "...", "-", more))
+    return out
+
+
+def _round_off(path: str, old: bytes, new: bytes, changes: list[Change]) -> bool:
+    """Do two versions of a file differ only below the tolerances (or in provenance)?"""
+    if path == layout.ROBOT_JSON:
+        return not any(c.kind in ("joint", "link", "robot_json") for c in changes)
+    if path.endswith((".stl", ".obj")):
+        return not any(c.kind == "mesh" and c.name == path for c in changes)
+    if path.endswith(".step"):
+        return not any(c.kind == "step" for c in changes)
+    if path.endswith(".glb"):
+        return glb_close(old, new)
+    if path.endswith((".usd", ".usda", ".usdc")):
+        return usd_close(path, old, new)
+    return text_close(old, new)
+
+
 def diff_files(
     old: dict[str, bytes], new: dict[str, bytes], old_name: str = "old", new_name: str = "new"
 ) -> Report:
@@ -186,7 +282,7 @@ def diff_files(
     report = Report(old_name, new_name)
     report.removed = sorted(set(old) - set(new))
     report.added = sorted(set(new) - set(old))
-    report.changed = sorted(p for p in set(old) & set(new) if old[p] != new[p])
+    differ = sorted(p for p in set(old) & set(new) if old[p] != new[p])
     a, b = _robot_json(old), _robot_json(new)
     report.changes += _entities(
         "joint",
@@ -198,7 +294,7 @@ def diff_files(
         "link", _by_name(a.get("links", [])), _by_name(b.get("links", [])), LINK_FIELDS
     )
     report.changes += _meshes(old, new)
-    if any(p.endswith(".step") and p in new and old[p] != new[p] for p in old):
+    if any(p.endswith(".step") for p in differ):
         from simkit.diff_step import step_changes
 
         report.changes += step_changes(old, new, Change)
@@ -215,92 +311,19 @@ def diff_files(
                     pieces_b.get(link, 0),
                 )
             )
-    keys = [k for k in b if k in a] + [k for k in a if k not in b] + [k for k in b if k not in a]
-    for key in keys:
-        if key in COVERED_KEYS or a.get(key) == b.get(key):
-            continue
-        kind = "added" if key not in a else "removed" if key not in b else "modified"
-        report.changes.append(Change("robot_json", key, kind))
+    report.changes += _other_entries(a, b)
+    for key in METADATA_KEYS:
+        report.metadata += [p for p, _x, _y in leaf_changes(a.get(key), b.get(key), 0.0, key)]
+    for path in differ:
+        kind = _round_off(path, old[path], new[path], report.changes)
+        (report.round_off if kind else report.changed).append(path)
     return report
 
 
 def diff_kits(old: Path, new: Path) -> Report:
     """Compare two kit folders or zips."""
-    return diff_files(load_kit(old), load_kit(new), str(old), str(new))
-
-
-def value_text(value, unit: str, field_name: str) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, (bool, str)):
-        return str(value)
-    if isinstance(value, (int, float)):
-        text = f"{num(value, 6)} {unit}".rstrip()
-        if unit.startswith("rad") and field_name in ANGLE_FIELDS:
-            text += f" ({num(math.degrees(value), 5)} deg{unit[3:]})"
-        return text
-    return f"({', '.join(num(v, 6) for v in value)}) {unit}".rstrip()
-
-
-def delta_text(change: Change) -> str:
-    a, b = change.old, change.new
-    if isinstance(a, bool) or isinstance(b, bool):
-        return ""
-    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        rel = f", {num(100 * (b - a) / a, 3)} %" if a else ""
-        return f"{'+' if b >= a else ''}{num(b - a, 6)} {change.unit}".rstrip() + rel
-    numeric = isinstance(a, list) and isinstance(b, list) and len(a) == len(b)
-    if numeric and all(isinstance(v, (int, float)) for v in a + b):
-        deltas = ", ".join(num(y - x, 6) for x, y in zip(a, b, strict=True))
-        return f"({deltas}) {change.unit}".rstrip()
-    return ""
-
-
-TITLES = {
-    "joint": "Joints",
-    "link": "Links",
-    "mesh": "Meshes",
-    "collision": "Collision pieces",
-    "step": "STEP solids (assembly frame, mm)",
-    "robot_json": "Other robot.json entries",
-}
-
-
-def to_markdown(report: Report) -> str:
-    """The report as Markdown, for a pull request comment."""
-    lines = [f"# simkit diff: `{report.old}` -> `{report.new}`", ""]
-    if report.equal:
-        return "\n".join([*lines, "No changes: every file is byte-identical.", ""])
-    lines += [
-        f"{len(report.changes)} semantic change(s); files: {len(report.added)} added, "
-        f"{len(report.removed)} removed, {len(report.changed)} changed.",
-        "",
-    ]
-    for kind, title in TITLES.items():
-        items = [c for c in report.changes if c.kind == kind]
-        if not items:
-            continue
-        lines += [f"## {title}", ""]
-        for c in items:
-            if c.change != "modified":
-                lines.append(f"- `{c.name}` {c.change}")
-        modified = [c for c in items if c.change == "modified"]
-        if modified and kind == "robot_json":
-            lines += [f"- `{c.name}` changed" for c in modified]
-        elif modified:
-            lines += ["| name | field | old | new | change |", "|---|---|---|---|---|"]
-            lines += [
-                f"| `{c.name}` | {c.field} | {value_text(c.old, c.unit, c.field)} | "
-                f"{value_text(c.new, c.unit, c.field)} | {delta_text(c)} |"
-                for c in modified
-            ]
-        lines.append("")
-    lines += ["## Files", ""]
-    for label, paths in (
-        ("added", report.added),
-        ("removed", report.removed),
-        ("changed", report.changed),
-    ):
-        if paths:
-            lines.append(f"- {label}: " + ", ".join(f"`{p}`" for p in paths))
-    return "\n".join([*lines, ""])
+    files = load_kit(old), load_kit(new)
+    try:
+        return diff_files(*files, str(old), str(new))
+    except RecursionError:  # a robot.json that json reads but is too deep to compare
+        raise SimkitError(f"{new}: {layout.ROBOT_JSON} is nested too deeply to compare") from None

@@ -3,12 +3,14 @@
 report files -> check -> publish (swap kit and zip into place).
 
 A build writes into a staging folder beside the output, checks it there, then swaps it into
-place; a failure at any step leaves the previous kit and zip untouched.
+place (kitio/atomic.py); a failure at any step leaves the previous kit and zip untouched, and
+a build whose files equal the published ones writes nothing there. Each build is recorded for
+the no-op rebuild (kitio/noop.py), which the CLI tries before importing this module.
 """
 
 from __future__ import annotations
 
-import shutil
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,8 +19,9 @@ from simkit.check import run_checks_cached
 from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
+from simkit.emit.ros2 import package_warning
 from simkit.errors import CheckFailed, SpecError, UnknownRobot
-from simkit.kitio import atomic, forked, layout
+from simkit.kitio import atomic, confine, forked, layout, manifest, noop, reuse
 from simkit.kitio.archive import zip_bytes
 from simkit.kitio.cache import (
     Arrays,
@@ -49,6 +52,10 @@ class BuildResult:
     zip_path: Path
     files: dict[str, bytes]
     findings: list[Finding] = field(default_factory=list)
+    #: one-line warnings about the spec (e.g. package.xml's maintainer left to the default)
+    warnings: tuple[str, ...] = ()
+    #: False when the published kit and zip already held these bytes (nothing was written)
+    changed: bool = True
 
 
 def find_spec(target: str) -> tuple[Path, str]:
@@ -104,6 +111,7 @@ EMIT_LIBRARIES = (
     "usd-core",
     "jinja2",
     "cadquery-ocp",
+    "cadquery-ocp-novtk",
 )
 #: Libraries the simulate stage's figures depend on.
 SIMULATE_LIBRARIES = ("numpy", "scipy", "mujoco", "matplotlib")
@@ -122,8 +130,11 @@ def _pack_files(files: dict[str, bytes]) -> Arrays:
 
 
 def _unpack_files(stored: Arrays) -> dict[str, bytes]:
+    """The files of an entry; a stored path that would leave the kit raises (a miss)."""
     blob = stored["blob"].tobytes()
-    return {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
+    files = {path: blob[start:end] for path, start, end in decode_json(stored["index"])}
+    confine.check_tree(files)
+    return files
 
 
 def _template_bytes() -> list[bytes]:
@@ -193,12 +204,10 @@ def _zip_cached(files: dict[str, bytes], top: str, cache: Cache) -> bytes:
     )
 
 
-def write_tree(root: Path, files: dict[str, bytes]) -> None:
-    """Write `files` (POSIX relative paths) under `root`."""
-    for rel, data in files.items():
-        target = root.joinpath(*rel.split("/"))
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(data)
+def write_tree(root: Path, files: dict[str, bytes], old_root: Path | None = None) -> None:
+    """Write `files` (POSIX relative paths) under `root`, each confined to it; files equal
+    to those under `old_root` are hard links to them (they keep their mtime: kitio/reuse.py)."""
+    reuse.write_tree(root, files, old_root)
 
 
 def build(
@@ -210,10 +219,12 @@ def build(
     jobs: int | None = None,
     usd_format: str = "usda",
     step: bool = True,
+    remember: bool = True,
 ) -> BuildResult:
     """Build one kit into `out_dir/NAME_description` and `out_dir/NAME-sim-kit.zip`;
     `usd_format`: "usda" (text) or "usdc" (binary) for `usd/NAME.*`; `step`: False leaves
-    out `step/NAME.step` (and the Open CASCADE import it costs).
+    out `step/NAME.step` (and the Open CASCADE import it costs); `remember`: record the
+    build for the no-op rebuild (kitio/noop.py; off for a throw-away `out_dir`).
 
     A build of a spec this code has not built before starts a warm worker at once, which
     imports Open CASCADE while the model is derived and then writes and checks the STEP
@@ -222,12 +233,24 @@ def build(
     hint = _rebuild_hint(target, cache, usd_format, step)
     cold = step and (hint is None or cache.get("built", hint) is None)
     with forked.warm_worker(("OCP",) if cold else ()):
-        result = _build(target, out_dir, check, progress, cache, jobs, usd_format, step)
+        result, named = _build(target, out_dir, check, progress, cache, jobs, usd_format, step)
     if hint is not None and cold and cache.enabled:
         import numpy as np
 
         cache.put("built", hint, {"built": np.ones(1, dtype=np.uint8)})
+    if remember and cache.enabled and not cache.readonly and cache.root is not None:
+        passed = sum(f.ok for f in result.findings)
+        counts = (passed, len(result.findings)) if check else None
+        options = noop.options(usd_format, step, check)
+        noop.remember(cache.root, target, out_dir, options, result.robot, named, counts)
     return result
+
+
+def _named_files(robot: Robot, target: str) -> list[Path]:
+    """The files the spec names (mesh files), which the no-op record watches."""
+    base = find_spec(target)[0].parent
+    shapes = [s for link in robot.links for s in (*link.shapes, *link.collision_shapes)]
+    return [base / s.file for s in shapes if s.file]
 
 
 def _rebuild_hint(target: str, cache: Cache, usd_format: str, step: bool) -> str | None:
@@ -250,44 +273,100 @@ def _build(
     jobs: int | None,
     usd_format: str,
     step: bool,
-) -> BuildResult:
-    """`build` after the warm worker is settled."""
+) -> tuple[BuildResult, list[Path]]:
+    """`build` after the warm worker is settled: the result and the files the spec names."""
     say = progress or (lambda _msg: None)
     robot = model_from_spec(target, progress, cache, jobs)
     step = step and robot.step  # the spec can leave the STEP out too
     say("emit")
     files = emit_cached(robot, usd_format, cache, step)
     kit_name = layout.kit_dir_name(robot.name)
-    lock = atomic.acquire(out_dir, robot.name)  # one build at a time into out_dir
-    staging = atomic.staging(out_dir, robot.name)
+    lock = atomic.acquire(out_dir)  # one build at a time into out_dir
     try:
-        staged_kit = staging / kit_name
-        write_tree(staged_kit, files)
-        say("simulate")
-        try:
-            reports = simulate_cached(staged_kit, robot, cache, step)
-        except SpecError as exc:  # e.g. freefall.pose: a release that leaves the limits
-            raise _located(target, exc) from None
-        clash = sorted(set(files) & set(reports))
-        if clash:
-            raise RuntimeError(f"a model emitter and a report emitter both write {clash[0]}")
-        write_tree(staged_kit, reports)
-        files = dict(sorted({**files, **reports}.items()))
-        staged_zip = staging / layout.zip_name(robot.name)
-        staged_zip.write_bytes(_zip_cached(files, kit_name, cache))
-        findings: list[Finding] = []
-        if check:
-            say("check")
-            findings = run_checks_cached(staged_kit, files, cache)
-            failed = [f for f in findings if not f.ok]
-            if failed:
-                lines = "; ".join(f.line() for f in failed[:3])
-                more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
-                raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
-        atomic.commit(staging, out_dir, robot.name)  # kit and zip as one unit (atomic.py)
+        said = atomic.repair(out_dir, robot.name)  # what a killed build left
+        if said:
+            print(f"simkit: warning: {said}", file=sys.stderr)
+        with atomic.staging_area(out_dir, robot.name) as staging:
+            files, findings, changed = _stage_and_publish(
+                target, robot, files, staging, out_dir, check, say, cache, step
+            )
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
         atomic.release(lock)
-    return BuildResult(
-        robot.name, out_dir / kit_name, out_dir / layout.zip_name(robot.name), files, findings
+    warning = package_warning(robot)
+    result = BuildResult(
+        robot.name,
+        out_dir / kit_name,
+        out_dir / layout.zip_name(robot.name),
+        files,
+        findings,
+        warnings=(warning,) if warning else (),
+        changed=changed,
     )
+    return result, _named_files(robot, target)
+
+
+def publish_files(
+    out_dir: Path, robot: str, files: dict[str, bytes], zip_data: bytes
+) -> tuple[Path, Path, bool]:
+    """Publish a kit built and checked elsewhere (a Ray worker) into `out_dir` exactly as a
+    local build publishes its own: under the output folder's lock, staged beside it with
+    unchanged files reused, and one atomic commit. Returns (kit folder, zip path, whether
+    anything changed)."""
+    lock = atomic.acquire(out_dir)
+    try:
+        said = atomic.repair(out_dir, robot)
+        if said:
+            print(f"simkit: warning: {said}", file=sys.stderr)
+        with atomic.staging_area(out_dir, robot) as staging:
+            atomic.stage_kit(staging, out_dir, robot, files)
+            atomic.stage_file(staging, out_dir, layout.zip_name(robot), zip_data)
+            record = manifest.make(robot, files, zip_data)
+            atomic.stage_file(staging, out_dir, manifest.name(robot), record)
+            changed = atomic.commit(staging, out_dir, robot)
+    finally:
+        atomic.release(lock)
+    return out_dir / layout.kit_dir_name(robot), out_dir / layout.zip_name(robot), changed
+
+
+def _stage_and_publish(
+    target: str,
+    robot: Robot,
+    files: dict[str, bytes],
+    staging: Path,
+    out_dir: Path,
+    check: bool,
+    say: Progress,
+    cache: Cache,
+    step: bool,
+) -> tuple[dict[str, bytes], list[Finding], bool]:
+    """Write the kit and zip into `staging`, simulate, check, and publish them (with the
+    lock held): (all files, findings, whether anything was published)."""
+    kit_name = layout.kit_dir_name(robot.name)
+    staged_kit = staging / kit_name
+    atomic.stage_kit(staging, out_dir, robot.name, files)
+    say("simulate")
+    try:
+        reports = simulate_cached(staged_kit, robot, cache, step)
+    except SpecError as exc:  # e.g. freefall.pose: a release that leaves the limits
+        raise _located(target, exc) from None
+    clash = sorted(set(files) & set(reports))
+    if clash:
+        raise RuntimeError(f"a model emitter and a report emitter both write {clash[0]}")
+    atomic.stage_kit(staging, out_dir, robot.name, reports)
+    files = dict(sorted({**files, **reports}.items()))
+    zip_data = _zip_cached(files, kit_name, cache)
+    atomic.stage_file(staging, out_dir, layout.zip_name(robot.name), zip_data)
+    atomic.stage_file(
+        staging, out_dir, manifest.name(robot.name), manifest.make(robot.name, files, zip_data)
+    )
+    findings: list[Finding] = []
+    if check:
+        say("check")
+        findings = run_checks_cached(staged_kit, files, cache)
+        failed = [f for f in findings if not f.ok]
+        if failed:
+            lines = "; ".join(f.line() for f in failed[:3])
+            more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
+            raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
+    changed = atomic.commit(staging, out_dir, robot.name)  # kit and zip as one unit
+    return files, findings, changed

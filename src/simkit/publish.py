@@ -12,6 +12,9 @@ The whole folder is built beside the output and swapped in at the end, so a fail
 leaves the previous publication in place. Publications into one folder serialize on a lock of
 its parent, and the swap is one `renameat2` exchange (`kitio.atomic.swap_folder`): a kill at
 any instant leaves the old site or the new one, and the next publish removes what it left.
+Files whose bytes did not change are hard links to the published ones (`kitio/reuse.py`), so
+they keep their mtime, and a publication equal to the published one writes nothing: an
+`rsync -a` to the server then sends only what changed.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from simkit.errors import SimkitError
-from simkit.kitio import atomic, layout
+from simkit.kitio import atomic, layout, reuse
 from simkit.kitio.jsonout import dumps
 from simkit.kitio.resources import robot_names
 from simkit.pipeline import build, find_spec, write_tree
@@ -60,10 +63,12 @@ def publish(
     out_dir: Path,
     targets: Sequence[str] | None = None,
     progress: Callable[[str], None] | None = None,
+    on_ray: bool = False,
     **build_options,
 ) -> dict:
     """Build `targets` (default: every robot in robots/), check them, and write the site
-    folder; returns the index. `build_options` go to `build.build` (cache, jobs)."""
+    folder; returns the index. `build_options` go to `build.build` (cache, jobs); `on_ray`:
+    one Ray task per robot (simkit/cluster.py), the site still written here."""
     say = progress or (lambda _msg: None)
     out_dir = Path(out_dir)
     _check_out_dir(out_dir)
@@ -71,7 +76,7 @@ def publish(
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     with atomic.locked(out_dir.parent):  # one publish into a folder at a time
         atomic.recover_folder(out_dir)
-        return _publish_locked(out_dir, names, say, build_options)
+        return _publish_locked(out_dir, names, say, {**build_options, "on_ray": on_ray})
 
 
 def _publish_locked(
@@ -86,9 +91,7 @@ def _publish_locked(
         site, work = staging / "site", staging / "kits"
         site.mkdir()
         kits = []
-        for target in names:
-            say(f"build {target}")
-            result = build(target, work, check=True, progress=say, **build_options)
+        for target, result in zip(names, _build_all(names, work, say, build_options), strict=True):
             top = layout.kit_dir_name(result.robot)
             folder = _asset_dir(target, result.robot)
             if any(kit["folder"] == f"{folder}/" for kit in kits):
@@ -97,8 +100,8 @@ def _publish_locked(
                     "another kit (set a distinct asset_dir in the spec)"
                 )
             zip_data = result.zip_path.read_bytes()
-            (site / result.zip_path.name).write_bytes(zip_data)
-            write_tree(site / folder, result.files)
+            reuse.write_file(site / result.zip_path.name, zip_data, out_dir / result.zip_path.name)
+            write_tree(site / folder, result.files, out_dir / folder)
             doc = json.loads(result.files[layout.ROBOT_JSON])
             kits.append(
                 {
@@ -118,8 +121,26 @@ def _publish_locked(
             "note": "paths are as in each zip; urls are relative to this file's folder",
             "kits": kits,
         }
-        (site / layout.INDEX_JSON).write_bytes(dumps(index))
-        atomic.swap_folder(site, out_dir)
+        reuse.write_file(site / layout.INDEX_JSON, dumps(index), out_dir / layout.INDEX_JSON)
+        if not reuse.same_tree(site, out_dir):  # else: the same publication, left untouched
+            if out_dir.is_dir():
+                reuse.keep_folder_times(site, out_dir)
+            atomic.swap_folder(site, out_dir)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return index
+
+
+def _build_all(names: list[str], work: Path, say: Callable[[str], None], options: dict) -> list:
+    """Every kit, built here one after another or as Ray tasks (`on_ray`), published into
+    `work` either way."""
+    options = dict(options)
+    if options.pop("on_ray", False):
+        from simkit.cluster import build_on_ray
+
+        return build_on_ray(names, work, say, check=True, **options)
+    results = []
+    for target in names:
+        say(f"build {target}")
+        results.append(build(target, work, check=True, progress=say, remember=False, **options))
+    return results

@@ -36,6 +36,7 @@ _REGISTRY: dict[str, str] = {
     "self_collision": "self_collision:check_self_collision",
     "step": "step:check_step",
     "generated": "generated:check_generated",
+    "sdf": "sdf:check_sdf",
 }
 
 
@@ -101,6 +102,7 @@ CHECK_LIBRARIES = (
     "usd-core",
     "manifold3d",
     "cadquery-ocp",
+    "cadquery-ocp-novtk",
 )
 
 

@@ -10,6 +10,7 @@ from simkit.check.fk import fk_agrees
 from simkit.check.kit import Kit
 from simkit.check.mujoco import random_configs
 from simkit.check.readers.glb import read_glb
+from simkit.kitio.obj import read_mesh
 from simkit.kitio.stl import from_stl
 from simkit.model.kinematics import axis_angle, quat_matrix, transform
 
@@ -69,7 +70,7 @@ def check_collision(kit: Kit) -> list[Finding]:
         most = max(most, len(paths))
         if report.get(link["name"], {}).get("pieces") != len(paths):
             mismatched.append(link["name"])
-        pieces = [from_stl(kit.path(p).read_bytes()) for p in paths]
+        pieces = [read_mesh(p, kit.path(p).read_bytes()) for p in paths]
         for piece in pieces:
             worst_convex = max(worst_convex, _dent(piece.vertices, piece.faces))
         if link["mesh"]["visual"]:

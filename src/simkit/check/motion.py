@@ -17,7 +17,7 @@ import numpy as np
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
 from simkit.model.kinematics import axis_angle, rpy_matrix, transform
-from simkit.simulate.benchmark import inverse_dynamics_model, kit_model_check
+from simkit.simulate.benchmark import inverse_dynamics_model, kit_model_check, mesh_assets
 from simkit.simulate.loaders import load_urdf_text
 
 N_CASES = 12  # kit page: "It holds twelve cases"
@@ -325,8 +325,7 @@ def check_benchmark(kit: Kit) -> list[Finding]:
     )
     text = kit.path(kit.mjcf).read_text(encoding="utf-8")
     payload = _payload(kit, bench["payload"]["cycle_1kg"])
-    meshes = kit.path("meshes")
-    assets = {f.relative_to(meshes).as_posix(): f.read_bytes() for f in meshes.rglob("*.stl")}
+    assets = mesh_assets(kit.root)
     result = kit_model_check(text, names, payload["link"], payload, q, qd, qdd, assets)
     recorded = bench["kit_model_check"]
     out.append(

@@ -9,7 +9,8 @@ Methods (spec `links[].collision`, issue 3 "What to build" 1):
   explicitly) on a coarse manifold copy of the solid, never on the visual mesh; then every
   visual vertex and face centre left outside the hulls is added to the nearest hull.
 - `primitives`: the spec's collision primitives, emitted as primitives by URDF/MJCF/USD.
-- `mesh`: the visual mesh itself (engines collide with its convex hull).
+- `mesh`: the visual solid's convex hull, one piece (issue 25: written as an OBJ piece like
+  any other, never as a collision pointing at the visual STL, which Drake's SceneGraph refuses).
 - `given`: the spec's `collision_shapes` (an imported URDF's own collision geometry), one
   convex hull each, merged down to `MAX_PIECES`, then grown to cover the visual like `coacd`.
 
@@ -73,10 +74,19 @@ def method_of(link: Link) -> str:
     return link.collision_method
 
 
+#: Per-method result revisions, in the cache key only where a method's result changed, so
+#: the other methods' cached pieces (CoACD's, minutes a robot) stay valid. `mesh` 2: the hull
+#: became a piece (issue 25); before, no pieces.
+METHOD_REVISION = {"mesh": 2}
+
+
 def key_params(link: Link, seed: int) -> dict[str, object]:
     """Every parameter the result depends on (for the cache key)."""
+    method = method_of(link)
+    revision = {"revision": METHOD_REVISION[method]} if method in METHOD_REVISION else {}
     return {
-        "method": method_of(link),
+        "method": method,
+        **revision,
         "shapes": [asdict(s) for s in link.shapes],
         "collision_primitives": [asdict(s) for s in link.collision_primitives],
         "max_pieces": MAX_PIECES,
@@ -394,9 +404,25 @@ def quality(solid: Mesh, pieces: list) -> dict:
 # --- the per-link step ------------------------------------------------------------------
 
 
+def _method_hulls(link: Link, method: str, seed: int) -> list:
+    """The convex manifolds a method gives before `cover` (none for `mesh`)."""
+    if method == "convex":
+        return convex_pieces(link.shapes)
+    if method == "given":
+        hulls = [_hull(h.vertices) for h in link.given_hulls]
+        hulls = [h for h in hulls if not h.is_empty() and h.volume() > 0]
+        return merge_greedy(hulls) if len(hulls) > MAX_PIECES else hulls
+    if method == "coacd":
+        return run_coacd(link.solid, seed)
+    return []
+
+
 def link_collision(link: Link, seed: int) -> tuple[tuple[Mesh, ...], dict]:
-    """Collision pieces (empty where the emitters use primitives or the visual mesh) and the
-    quality report of one link whose `solid` is derived."""
+    """Collision pieces (empty where the emitters use primitives, or the link has no solid)
+    and the quality report of one link whose `solid` is derived. A link with a solid and no
+    primitives always gets pieces: where its method gives none (`mesh`, or nothing left of
+    a decomposition) the solid's convex hull is its one piece, so no emitter has to fall
+    back to the visual mesh."""
     from simkit.derive.solids import primitive_solid
 
     method = method_of(link)
@@ -410,19 +436,11 @@ def link_collision(link: Link, seed: int) -> tuple[tuple[Mesh, ...], dict]:
         return (), report
     if link.solid is None:
         return (), {"method": method, "pieces": 0}
-    if method == "mesh":
-        return (), {"method": method, **quality(link.solid, [_manifold(link.solid).hull()])}
-    if method == "convex":
-        hulls = convex_pieces(link.shapes)
-    elif method == "given":
-        hulls = [_hull(h.vertices) for h in link.given_hulls]
-        hulls = [h for h in hulls if not h.is_empty() and h.volume() > 0]
-        hulls = merge_greedy(hulls) if len(hulls) > MAX_PIECES else hulls
-        hulls = (
-            cover(hulls, surface_samples(link.solid)) if hulls else [_manifold(link.solid).hull()]
-        )
-    else:
-        hulls = cover(run_coacd(link.solid, seed), surface_samples(link.solid))
+    hulls = _method_hulls(link, method, seed)
+    if hulls and method in ("given", "coacd"):
+        hulls = cover(hulls, surface_samples(link.solid))
+    elif not hulls:  # `mesh`, or a decomposition that left nothing: one piece, the hull
+        hulls = [_manifold(link.solid).hull()]
     meshes = [convex_mesh(h) for h in hulls]
     order = sorted(range(len(meshes)), key=lambda i: tuple(np.round(meshes[i].vertices.mean(0), 9)))
     hulls, meshes = [hulls[i] for i in order], [meshes[i] for i in order]

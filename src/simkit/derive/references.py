@@ -17,9 +17,25 @@ def _distance_from_axis(point: np.ndarray, origin: np.ndarray, axis: np.ndarray)
     return float(np.linalg.norm(r - axis * (axis @ r)))
 
 
+def _tool_chain_first(robot: Robot) -> list:
+    """Movable joints, the first on the tool frame's chain first: the base frame is that
+    joint's parent, which every FK from base to tool passes (a joint listed earlier may sit
+    on another branch, such as a pan joint on a pedestal beside the arm)."""
+    movable = list(robot.movable_joints)
+    parent_joint = {j.child: j for j in robot.joints}
+    frame_parent = {f.name: f.parent for f in robot.frames}
+    node = frame_parent.get(robot.tool_frame, robot.tool_frame)
+    chain: list = []
+    while node in parent_joint and len(chain) <= len(robot.joints):
+        chain.append(parent_joint[node])
+        node = chain[-1].parent
+    on_chain = [j for j in reversed(chain) if j.movable]
+    return on_chain[:1] + [j for j in movable if j not in on_chain[:1]]
+
+
 def derive_references(robot: Robot) -> Robot:
     """FK reference poses (wrist centre, tool pose in the first link's frame) and reach."""
-    movable = robot.movable_joints
+    movable = _tool_chain_first(robot)
     base = movable[0].parent if movable else robot.root
     tool = robot.tool_frame
     fk_reference = []

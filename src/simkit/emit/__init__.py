@@ -20,6 +20,7 @@ from simkit.emit import (
     robot_json,
     ros2,
     ros2_control,
+    sdf,
     srdf,
     step,
     urdf,
@@ -44,6 +45,7 @@ EMITTERS: dict[str, Emitter] = {
     "glb": glb.emit,
     "ros2_control": ros2_control.emit,
     "step": step.emit,
+    "sdf": sdf.emit,
 }
 
 

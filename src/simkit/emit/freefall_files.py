@@ -7,9 +7,17 @@ same trajectories give the same bytes (PNG itself carries no timestamp).
 
 from __future__ import annotations
 
+import contextlib
 import io
+import os
+import shutil
+import sys
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
 
 from simkit.kitio import layout
+from simkit.kitio.cache import default_dir
 from simkit.kitio.fmt import num
 from simkit.model.robot import Robot, SimReports
 
@@ -38,8 +46,9 @@ def csv_text(data: dict) -> str:
 
 def plot_png(robot: Robot, data: dict) -> bytes:
     """One panel per joint: the three simulations of the plotted run superimposed."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    with matplotlib_home():
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
 
     joints, sides = data["joints"], data["trajectories"][PLOTTED_RUN]
     fig = Figure(figsize=(8.0, 2.4 * len(joints) + 1.4), dpi=100)
@@ -67,6 +76,35 @@ def plot_png(robot: Robot, data: dict) -> bytes:
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", metadata={"Software": None})
     return buffer.getvalue()
+
+
+@contextlib.contextmanager
+def matplotlib_home() -> Iterator[None]:
+    """Import matplotlib with MPLCONFIGDIR in simkit's cache folder (`matplotlib/`: its font
+    list) where that folder exists, else in a temporary folder removed afterwards (about
+    0.5 s to rebuild the font list): by default it writes
+    ~/.config/matplotlib and ~/.cache/matplotlib, and a build writes nothing outside --out
+    but simkit's cache. A user's own MPLCONFIGDIR, or matplotlib already imported, is kept."""
+    if "MPLCONFIGDIR" in os.environ or "matplotlib" in sys.modules:
+        yield
+        return
+    scratch = None
+    try:  # never create the cache folder for this alone (--no-cache, --cache-dir elsewhere)
+        home = default_dir() / "matplotlib"
+        if not home.parent.is_dir():
+            raise FileNotFoundError(home.parent)
+        home.mkdir(exist_ok=True)
+    except OSError:  # no cache folder, or an unwritable one
+        home = scratch = Path(tempfile.mkdtemp(prefix="simkit-matplotlib-"))
+    os.environ["MPLCONFIGDIR"] = str(home)
+    try:
+        import matplotlib  # noqa: F401  (reads MPLCONFIGDIR once, on import)
+
+        yield
+    finally:
+        os.environ.pop("MPLCONFIGDIR", None)
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
 
 
 def emit(robot: Robot, reports: SimReports) -> dict[str, bytes]:

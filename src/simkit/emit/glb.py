@@ -7,8 +7,9 @@ node turns the kit's Z-up frames upright. Materials come from the spec's colours
 
 Layout follows the glTF 2.0 specification (Khronos, "GLB File Format Specification"): a 12-byte
 header, a JSON chunk padded with spaces and a BIN chunk padded with zeros, both to 4 bytes.
-Positions are float32, indices uint16 or uint32; no normals, so viewers shade flat (spec
-section 3.7.2.1). Byte-identical across builds: no clock, fixed order, `jsonout` numbers.
+Positions and normals are float32, indices uint16 or uint32. Normals (kitio/normals.py) are
+smooth across curved surfaces and split at creases, so a vertex on an edge is written once
+per face normal there. Byte-identical across builds: no clock, fixed order, `jsonout` numbers.
 
 Node names are the URDF link names, exactly (issue 12). A loader may rename one on load: trimesh
 turns a node called "world" (the ECN 2R's root link) into "world_1", its own root being "world".
@@ -24,6 +25,7 @@ import numpy as np
 from simkit import __version__
 from simkit.kitio import layout
 from simkit.kitio.fmt import ZERO_BELOW, rounded
+from simkit.kitio.normals import corner_normals, split_vertices
 from simkit.model.kinematics import quat_wxyz, rpy_matrix
 from simkit.model.robot import Joint, Robot
 
@@ -163,13 +165,18 @@ def document(robot: Robot) -> tuple[dict, bytes]:
         link = robot.link(joint.child)
         node = _place({"name": link.name}, joint.xyz, joint.rpy)
         if link.solid is not None:
-            positions = np.asarray(link.solid.vertices, dtype="<f4")
+            positions, normals, faces = split_vertices(
+                link.solid.vertices,
+                link.solid.faces,
+                corner_normals(link.solid.vertices, link.solid.faces),
+            )
+            positions = positions.astype("<f4")
             # round-off below fmt's zero threshold is written as 0 in min/max: match the data
             positions = np.where(np.abs(positions) < ZERO_BELOW, 0, positions).astype("<f4")
-            faces = np.asarray(link.solid.faces)
             small = len(positions) < 65536
             indices = faces.astype("<u2" if small else "<u4").ravel()
             pos = buf.add(positions, ARRAY_BUFFER, FLOAT, "VEC3", bounds=True)
+            nrm = buf.add(normals.astype("<f4"), ARRAY_BUFFER, FLOAT, "VEC3")
             idx = buf.add(
                 indices, ELEMENT_ARRAY_BUFFER, UNSIGNED_SHORT if small else UNSIGNED_INT, "SCALAR"
             )
@@ -179,7 +186,7 @@ def document(robot: Robot) -> tuple[dict, bytes]:
                     "name": link.name,
                     "primitives": [
                         {
-                            "attributes": {"POSITION": pos},
+                            "attributes": {"POSITION": pos, "NORMAL": nrm},
                             "indices": idx,
                             "material": material_index[material],
                             "mode": 4,

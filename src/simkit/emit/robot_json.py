@@ -17,6 +17,15 @@ from simkit.spec import urdf_blocks
 LIBRARIES = ("numpy", "manifold3d", "trimesh", "coacd", "mujoco", "usd-core", "cadquery-ocp")
 
 
+def _libraries() -> dict[str, str | None]:
+    """`LIBRARIES`' versions; "cadquery-ocp" is OCP's, from cadquery-ocp-novtk (the same OCP
+    without VTK, the dependency) when cadquery-ocp itself is not installed."""
+    versions = library_versions((*LIBRARIES, "cadquery-ocp-novtk"))
+    novtk = versions.pop("cadquery-ocp-novtk")
+    versions["cadquery-ocp"] = versions["cadquery-ocp"] or novtk
+    return versions
+
+
 def _deg(value: float | None) -> float | None:
     return None if value is None else math.degrees(value)
 
@@ -186,7 +195,7 @@ def document(robot: Robot, reports: SimReports) -> dict:
             "spec": robot.spec_file,
             "spec_sha256": robot.spec_sha256,
             "simkit_version": __version__,
-            "libraries": library_versions(LIBRARIES),
+            "libraries": _libraries(),
             "seeds": {"spec": robot.seed, **products.seeds},
             "sources": list(robot.sources),
             "published_estimated": list(robot.published_estimated),

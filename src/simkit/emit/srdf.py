@@ -29,20 +29,36 @@ def planning_groups(robot: Robot) -> list[PlanningGroup]:
     if not movable or robot.tool_frame is None:
         return []
     base = robot.products.base_frame or movable[0].parent
+    chain = _chain(robot, robot.tool_frame)
+    if base not in {j.parent for j in chain}:  # the first movable joint is on another branch
+        on_chain = [j for j in chain if j.movable]
+        if not on_chain:
+            return []
+        base = on_chain[-1].parent
     return [PlanningGroup(DEFAULT_GROUP, base, robot.tool_frame)]
+
+
+def _chain(robot: Robot, tip: str) -> list:
+    """The joints from `tip` up to the root, tip first."""
+    frame_parent = {f.name: f.parent for f in robot.frames}
+    parent_joint = {j.child: j for j in robot.joints}
+    node, out = frame_parent.get(tip, tip), []
+    while node in parent_joint and len(out) <= len(robot.joints):
+        out.append(parent_joint[node])
+        node = out[-1].parent
+    return out
 
 
 def group_joints(robot: Robot, group: PlanningGroup) -> list[str]:
     """Movable joints on the chain from the group's base to its tip, base first."""
-    frame_parent = {f.name: f.parent for f in robot.frames}
-    parent_joint = {j.child: j for j in robot.joints}
-    node = frame_parent.get(group.tip, group.tip)
     out = []
-    while node != group.base:
-        joint = parent_joint[node]
+    for joint in _chain(robot, group.tip):
+        if joint.child == group.base:
+            break
         if joint.movable:
             out.append(joint.name)
-        node = joint.parent
+        if joint.parent == group.base:
+            break
     return out[::-1]
 
 

@@ -32,6 +32,7 @@ import numpy as np
 from simkit.errors import SimkitError
 from simkit.kitio import layout
 from simkit.kitio.fmt import rounded
+from simkit.kitio.normals import corner_normals
 from simkit.model.inertia import principal_axes
 from simkit.model.kinematics import forward, jointed_pairs, quat_wxyz, rpy_matrix
 from simkit.model.robot import Link, Mesh, Robot, Shape
@@ -118,19 +119,8 @@ def _points(vertices: np.ndarray):
     return Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(v)), v
 
 
-def _face_normals(mesh: Mesh) -> np.ndarray:
-    """One unit normal per face corner (faceVarying): flat shading, as the solids are CAD-like
-    envelopes with sharp edges."""
-    tri = mesh.vertices[mesh.faces]
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    n = n / np.where(length > 0, length, 1.0)
-    n = np.round(n, 7) + 0.0  # normals are for shading: 7 digits, no -0
-    return np.repeat(n, mesh.faces.shape[1], axis=0)
-
-
 def _mesh(stage, path: str, mesh: Mesh, normals: bool):
-    from pxr import Gf, UsdGeom, Vt
+    from pxr import Gf, Sdf, UsdGeom, Vt
 
     geom = UsdGeom.Mesh.Define(stage, path)
     points, arr = _points(mesh.vertices)
@@ -140,9 +130,12 @@ def _mesh(stage, path: str, mesh: Mesh, normals: bool):
     lo, hi = arr.min(axis=0), arr.max(axis=0)
     geom.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*lo.tolist()), Gf.Vec3f(*hi.tolist())]))
     if normals:
-        data = _face_normals(mesh).astype(np.float32)
-        geom.CreateNormalsAttr(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(data)))
-        geom.SetNormalsInterpolation(UsdGeom.Tokens.faceVarying)
+        # the GLB's normals (kitio/normals.py): smooth on curved surfaces, sharp at creases;
+        # a primvar, one per face corner, so both files shade alike
+        data = corner_normals(mesh.vertices, mesh.faces).reshape(-1, 3).astype(np.float32)
+        UsdGeom.PrimvarsAPI(geom).CreatePrimvar(
+            "normals", Sdf.ValueTypeNames.Normal3fArray, UsdGeom.Tokens.faceVarying
+        ).Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(data)))
     geom.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     return geom
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from simkit.errors import SpecError
 from simkit.importer.draft import Draft
+from simkit.importer.reading import ReadOptions
 from simkit.importer.report import Report
 
 
@@ -77,22 +78,26 @@ def import_robot(
     strict: bool = False,
     floating: bool | None = None,
     hull_collision: bool = False,
+    reading: ReadOptions | None = None,
     density: float | None = None,
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `floating`: True or False sets the base; None decides it from the robot's structure
     (base.py; reported). `hull_collision`: links whose URDF collision has meshes collide
     with their visual solid's convex hull instead (one piece; reported per link).
-    `density` (kg/m^3, default masses.DENSITY): a massless link's mass from its solid."""
+    `reading`: what the reader may do (xacro args, environment, files outside the package;
+    importer/reading.py). `density` (kg/m^3, default masses.DENSITY): a massless link's
+    mass from its solid."""
     from simkit.importer import base, fixups, masses, source, writer
 
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
-    doc = source.load(path, package_dirs)
+    report = Report(strict=strict)
+    doc = source.load(path, package_dirs, report, reading)
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".import-") as tmp:
-        draft = Draft(doc, path, Path(tmp), Report(strict=strict))
+        draft = Draft(doc, path, Path(tmp), report)
         draft.legged, why = base.decide(doc)
         if floating is None:
             floating = draft.legged

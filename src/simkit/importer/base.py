@@ -21,7 +21,7 @@ from simkit.importer.source import Source
 LEG = 0.25
 #: m: and at least this far below it (a flat robot's arms are no legs)
 MIN_DROP = 0.02
-MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
+MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating", "spherical")
 
 
 def _transform(source: Source, element) -> np.ndarray:

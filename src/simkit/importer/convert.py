@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from simkit.importer.ball_joints import expand as expand_ball_joints
 from simkit.importer.geometry import floats
 from simkit.importer.joints import joint_spec, mimic_limits
 from simkit.importer.links import has_geometry, has_mass, link_spec
@@ -64,12 +65,15 @@ def _children(by_child: dict) -> dict[str, list[str]]:
 
 
 def _load(source, name, links, kids, by_child) -> tuple[float, float]:
-    """Mass (kg) of a link's subtree and a lever arm (m): the longest chain of joint offsets."""
-    mass = 0.0
+    """Mass (kg) of a link's subtree and a lever arm (m): the longest chain of joint offsets
+    or CoM offset (a long link without children, such as a neck, holds its CoM that far)."""
+    mass, arm = 0.0, 0.0
     element = links[name].find("inertial/mass")
     if has_mass(links[name]):
         mass = floats(source, element, "value", 1)
-    arm = 0.0
+        com = links[name].find("inertial/origin")  # its own CoM is a lever arm too
+        if com is not None:
+            arm = float(np.linalg.norm(floats(source, com, "xyz", 3, "0 0 0")))
     for child in kids.get(name, []):
         sub_mass, sub_arm = _load(source, child, links, kids, by_child)
         xyz = by_child[child].find("origin")
@@ -119,6 +123,7 @@ def convert(
             report.dropped(
                 source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
             )
+    expand_ball_joints(source)  # spherical joints: three revolute ones (ball_joints.py)
     links, by_child, root = tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)

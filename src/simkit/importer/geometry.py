@@ -2,20 +2,32 @@
 
 from __future__ import annotations
 
+from simkit.importer.lenient import first_numbers, loose_numbers
 from simkit.importer.meshes import MeshWriter
 from simkit.importer.report import Report
-from simkit.importer.source import Source, resolve_uri
+from simkit.importer.source import MissingMesh, Source, resolve_uri
 
 
 def floats(source: Source, element, attr: str, count: int, default: str | None = None):
-    """`count` floats from a space-separated attribute; one-line error if malformed."""
+    """`count` floats from a space-separated attribute; one-line error if malformed. A
+    longer vector gives its first `count` numbers, read leniently (as PyBullet does)."""
     text = element.get(attr, default)
     if text is None:
         raise source.fail(element, f"missing attribute '{attr}'")
+    longer = first_numbers(text, count) if count > 1 else None
+    if longer is not None and all(v == v and abs(v) != float("inf") for v in longer):
+        source.lenient(
+            element, f"'{attr}' has more than {count} numbers ('{text}'): the first {count}"
+        )
+        return longer
     try:
         values = tuple(float(v) for v in text.split())
     except ValueError:
-        raise source.fail(element, f"'{attr}' is not a number list: '{text}'") from None
+        values = loose_numbers(text)
+        if values is None:
+            raise source.fail(element, f"'{attr}' is not a number list: '{text}'") from None
+        shown = " ".join(f"{v:g}" for v in values)
+        source.lenient(element, f"'{attr}' is '{text}': read as '{shown}' (as C's strtod reads it)")
     if len(values) != count or any(v != v or abs(v) == float("inf") for v in values):
         raise source.fail(element, f"'{attr}' needs {count} finite numbers, got '{text}'")
     return values if count > 1 else values[0]
@@ -71,7 +83,10 @@ def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: 
         uri = shape.get("filename")
         if not uri:
             raise source.fail(shape, "mesh without 'filename'")
-        path = resolve_uri(source, shape, uri)
+        try:
+            path = resolve_uri(source, shape, uri)
+        except MissingMesh as exc:
+            return _missing(source, element, shape, exc.message, what)
         scale = floats(source, shape, "scale", 3, "1 1 1")
         if min(abs(s) for s in scale) <= 0:
             raise source.fail(shape, f"mesh scale must be non-zero, got {scale}")
@@ -83,3 +98,58 @@ def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: 
         return {"shape": "mesh", "file": info.file, **pose}, info
     report.dropped(source, shape, f"{what} geometry <{kind}> is not supported")
     return None
+
+
+def _missing(source: Source, element, shape, why: str, what: str):
+    """A mesh no rule finds: this geometry is left out (as PyBullet does), reported; a link
+    left with no geometry at all gets an estimated box instead (importer/solids.py)."""
+    link = element.getparent()
+    if any(_usable(source, other) for other in link if other is not element):
+        source.lenient(shape, f"{why}: this {what} is left out")
+        return None
+    box = _estimated_box(source, link)
+    source.lenient(
+        shape,
+        f"{why}: this {what} is left out; the link has no other geometry, so it gets an "
+        f"estimated box {' x '.join(f'{s:g}' for s in box['size'])} m (importer/solids.py)",
+    )
+    return box, None
+
+
+def _usable(source: Source, element) -> bool:
+    """Whether a `<visual>`/`<collision>` has geometry other than a mesh no rule finds."""
+    if element.tag not in ("visual", "collision"):
+        return False
+    mesh = element.find("geometry/mesh")
+    if mesh is None:
+        return element.find("geometry") is not None
+    try:
+        resolve_uri(source, mesh, mesh.get("filename") or "")
+    except MissingMesh:
+        return False
+    except Exception:  # refused or ambiguous: reported when that element is read
+        return True
+    return True
+
+
+def _estimated_box(source: Source, link) -> dict:
+    """The box solids.py gives a geometry-free link: bounding its origin, CoM and child
+    joints, holding its mass (or the massless placeholder) at water's density."""
+    import numpy as np
+
+    from simkit.importer.solids import estimated_box
+
+    mass_el = link.find("inertial/mass")
+    try:
+        mass = float(mass_el.get("value", "0")) if mass_el is not None else 0.0
+    except ValueError:
+        mass = 0.0
+    points = [(0.0, 0.0, 0.0)]
+    inertial = link.find("inertial")
+    if inertial is not None:
+        points.append(origin(source, inertial)[0])
+    for joint in source.root.findall("joint"):
+        parent = joint.find("parent")
+        if parent is not None and parent.get("link") == link.get("name"):
+            points.append(origin(source, joint)[0])
+    return estimated_box(mass if mass > 0 else 0.001, np.array(points, dtype=float))

@@ -54,6 +54,12 @@ def joint_spec(source: Source, joint, report: Report, load: tuple[float, float])
             f"revolute limits beyond {TURNS} turns (a placeholder for none, e.g. a rotor): "
             "imported as continuous",
         )
+    elif kind == "revolute" and _reversed(joint):
+        kind = spec["type"] = "continuous"
+        source.lenient(
+            joint.find("limit"),
+            "lower > upper, which Bullet reads as no limit: imported as continuous",
+        )
     estimated: list[str] = []
     spec.update(_limits(source, joint, kind, report, load, estimated))
     dynamics = joint.find("dynamics")
@@ -89,7 +95,9 @@ def _limits(
         lower = None if limit is None else limit.get("lower")
         upper = None if limit is None else limit.get("upper")
         same = lower is not None and upper is not None and _num(lower) == _num(upper)
-        if (lower is None and upper is None) or same:
+        if _reversed(joint):  # a prismatic one (a revolute one became continuous)
+            source.lenient(limit, "lower > upper, which Bullet reads as no limit")
+        if (lower is None and upper is None) or same or _reversed(joint):
             span = math.pi if kind == "revolute" else 0.1
             unit = "rad" if kind == "revolute" else "m"
             why = "lower == upper (no range)" if same else "no position limits"
@@ -139,6 +147,16 @@ def _unbounded(joint) -> bool:
         return False
     values = [_num(limit.get(key, "0")) for key in ("lower", "upper")]
     return any(v is not None and abs(v) > TURNS * 2 * math.pi for v in values)
+
+
+def _reversed(joint) -> bool:
+    """A `<limit>` whose lower exceeds its upper (cube_no_rotation.urdf: 1 > -1): Bullet
+    reads it as no limit."""
+    limit = joint.find("limit")
+    if limit is None:
+        return False
+    lower, upper = _num(limit.get("lower", "0")), _num(limit.get("upper", "0"))
+    return lower is not None and upper is not None and lower > upper
 
 
 def _num(text: str) -> float | None:

@@ -1,23 +1,31 @@
-"""Crash-consistent publishing of a kit folder and its zip, as one unit.
+"""Crash-safe publishing of a kit folder and its zip as real folder and file in `--out`.
 
-A build writes the kit and the zip into a staging folder `.NAME.<id>.staging` beside the
-output, checks them there, and publishes them with one atomic step:
+    out/NAME_description/         the kit, a plain folder
+    out/NAME-sim-kit.zip          its zip, a plain file
+    out/.NAME.manifest.json       hidden: both digests (`manifest.py`)
 
-    out/NAME_description    -> .NAME.current/NAME_description   (fixed symlinks)
-    out/NAME-sim-kit.zip    -> .NAME.current/NAME-sim-kit.zip
-    out/.NAME.current       -> .NAME.<id>.gen                   (switched by one rename)
-    out/.NAME.<id>.gen/     NAME_description/ and NAME-sim-kit.zip of one build
+A build writes the kit, the zip and the new manifest into a staging folder
+`.NAME.<id>.staging` beside them and checks them there; unchanged files are hard links to the
+published ones (`reuse.py`). When nothing differs, nothing is published: no byte, name or
+mtime under `--out` changes. Otherwise the staging folder is renamed to the journal
+`.NAME.commit` and rolled forward, each step idempotent:
 
-Switching `.NAME.current` is a single `rename(2)` of a new symlink over the old one, so
-after a kill -9 at any instant the visible kit and zip are those of one and the same build,
-the old one or the new one. Whatever a kill leaves behind (staging folders, unused
-generations, temporary links, the `.old` folders of simkit's earlier swap) the next build
-into the folder removes. A kit folder and zip written by an earlier simkit (plain folder
-and file) are moved into a generation first; the folder is exchanged for its symlink with
-`renameat2(RENAME_EXCHANGE)`, so that step is atomic too.
+1. the staged kit folder and the published one are exchanged by one
+   `renameat2(RENAME_EXCHANGE)` (Linux); the journal records the staged folder's inode, so a
+   rerun knows whether this happened;
+2. the zip, then the manifest, are renamed over the published ones (`rename(2)`);
+3. the journal (now holding the old kit) is renamed to `.NAME.<id>.trash` and removed.
 
-Builds into one output folder serialize on an `flock` of the folder itself (no lock file).
-Test hook: `SIMKIT_TEST_KILL_AT=<step>` kills the process with SIGKILL at that step.
+A kill -9 at any instant leaves a kit and a zip of one build, except between steps 1 and 2
+(the new kit beside the old zip): there the journal is still present, `simkit check` reports
+the mismatch, and the next build into the folder says so on one line and finishes the
+publish (`repair`). Without renameat2 (macOS, other filesystems) step 1 is two renames, the
+old kit moved into the journal and the new one into place; a kill between them leaves no kit
+folder until the next build finishes the publish. A kit folder left as a symlink by an
+earlier simkit (`.NAME.current` generations) is replaced by the same exchange.
+
+Builds into one folder serialize on an `flock` of the folder itself (no lock file). Test hook:
+`SIMKIT_TEST_KILL_AT=<step>` kills the process with SIGKILL at that step.
 """
 
 from __future__ import annotations
@@ -32,24 +40,25 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from simkit.errors import SimkitError
-from simkit.kitio import layout
+from simkit.kitio import layout, manifest, reuse
 
 KILL_ENV = "SIMKIT_TEST_KILL_AT"
 #: The publishing steps, in order, at which the test hook can kill a build.
 STEPS = (
     "locked",
     "staged",
-    "legacy_copied",
-    "legacy_current",
-    "legacy_zip",
-    "legacy_kit",
-    "generation",
-    "switched",
-    "linked",
+    "journaled",
+    "kit_aside",  # only without renameat2
+    "kit_swapped",
+    "zip_moved",
+    "manifest_moved",
+    "journal_closed",
     "cleaned",
 )
 #: The steps of `swap_folder` (simkit publish's site folder) at which the hook can kill.
 FOLDER_STEPS = ("site_staged", "site_moved_aside", "site_swapped")
+_INODE = "kit.inode"
+_OLD_KIT = "old_kit"
 
 
 def step(name: str) -> None:
@@ -70,19 +79,17 @@ def _writable(out_dir: Path) -> None:
         raise SimkitError(f"{out_dir}: the output folder is not writable")
 
 
-def acquire(out_dir: Path, robot: str | None = None) -> int:
-    """Take an exclusive `flock` on `out_dir` (waits for another build into it to finish);
-    with `robot`, then `repair` what a killed build of it left. Returns the fd for
-    `release`."""
+def acquire(out_dir: Path, shared: bool = False) -> int:
+    """Take an `flock` on `out_dir` (exclusive; `shared` for readers that write nothing),
+    waiting for another build into it to finish. Returns the fd for `release`."""
     import fcntl
 
-    _writable(out_dir)
+    if not shared:
+        _writable(out_dir)
     fd = os.open(out_dir, os.O_RDONLY)
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
+        fcntl.flock(fd, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
         step("locked")
-        if robot is not None:
-            repair(out_dir, robot)
     except BaseException:
         os.close(fd)
         raise
@@ -104,12 +111,13 @@ def locked(out_dir: Path) -> Iterator[None]:
         release(fd)
 
 
-def _current(out_dir: Path, robot: str) -> Path:
-    return out_dir / f".{robot}.current"
-
-
-def _visible(out_dir: Path, robot: str) -> tuple[Path, Path]:
-    return out_dir / layout.kit_dir_name(robot), out_dir / layout.zip_name(robot)
+def _visible(out_dir: Path, robot: str) -> tuple[Path, Path, Path]:
+    """(kit folder, zip, manifest) as published in `out_dir`."""
+    return (
+        out_dir / layout.kit_dir_name(robot),
+        out_dir / layout.zip_name(robot),
+        out_dir / manifest.name(robot),
+    )
 
 
 def _remove(path: Path) -> None:
@@ -119,43 +127,41 @@ def _remove(path: Path) -> None:
         shutil.rmtree(path, ignore_errors=True)
 
 
-def _live_generation(out_dir: Path, robot: str) -> str | None:
-    link = _current(out_dir, robot)
-    return os.readlink(link) if link.is_symlink() else None
-
-
-def clean(out_dir: Path, robot: str) -> None:
-    """Remove what an interrupted build of `robot` left (call with the lock held): staging
-    folders, generations `.NAME.current` does not point to, temporary links, `.old` folders."""
-    live = _live_generation(out_dir, robot)
-    kit, zip_path = _visible(out_dir, robot)
-    for path in sorted(out_dir.glob(f".{robot}.*")):
-        name = path.name
-        stale = (
-            name.endswith((".staging", ".tmp"))
-            or (name.endswith(".gen") and name != live)
-            or name == f".{robot}.legacy"
-        )
-        if stale:
-            _remove(path)
-    for old in (f".{kit.name}.old", f".{zip_path.name}.old"):
-        _remove(out_dir / old)
-
-
 def staging(out_dir: Path, robot: str) -> Path:
-    """A fresh staging folder for `robot` beside the output (readable as any folder: it
-    becomes the published generation)."""
+    """A fresh staging folder for `robot` beside the output (its kit folder is published as
+    it is, so it is readable as any folder)."""
     path = Path(tempfile.mkdtemp(prefix=f".{robot}.", suffix=".staging", dir=out_dir))
     path.chmod(0o755)
     return path
 
 
-def _link(out_dir: Path, robot: str, target: str, at: Path) -> None:
-    """Point symlink `at` to `target` atomically (a temp link, which `clean` removes if a
-    kill leaves it, renamed over it)."""
-    tmp = out_dir / f".{robot}.{secrets.token_hex(4)}.tmp"
-    os.symlink(target, tmp)
-    os.replace(tmp, at)
+@contextlib.contextmanager
+def staging_area(out_dir: Path, robot: str) -> Iterator[Path]:
+    """`staging`, removed on exit. When nothing was published from it (`commit` renames it,
+    so it is gone then), `out_dir` gets back its mtime: a build that changed nothing, or
+    failed, leaves no trace there."""
+    st = out_dir.stat()
+    path = staging(out_dir, robot)
+    try:
+        yield path
+    finally:
+        published = not path.exists()
+        _remove(path)
+        if not published:
+            os.utime(out_dir, ns=(st.st_atime_ns, st.st_mtime_ns))
+
+
+def stage_kit(staged: Path, out_dir: Path, robot: str, files: dict[str, bytes]) -> int:
+    """Write kit `files` into `staged`, hard-linking the published kit's unchanged files;
+    returns how many were reused."""
+    kit = _visible(out_dir, robot)[0]
+    return reuse.write_tree(staged / kit.name, files, kit)
+
+
+def stage_file(staged: Path, out_dir: Path, name: str, data: bytes) -> None:
+    """Write the zip or the manifest (`name`, as published in `out_dir`) into `staged`,
+    hard-linking the published one when unchanged."""
+    reuse.write_file(staged / name, data, out_dir / name)
 
 
 def _exchange(a: Path, b: Path) -> bool:
@@ -177,69 +183,97 @@ def _exchange(a: Path, b: Path) -> bool:
     raise OSError(code, os.strerror(code), str(a))
 
 
-def _adopt_legacy(out_dir: Path, robot: str) -> None:
-    """Move a plain kit folder / zip (written before this scheme) into a generation, keeping
-    what is visible unchanged at every instant."""
-    kit, zip_path = _visible(out_dir, robot)
-    plain = [p for p in (kit, zip_path) if p.exists() and not p.is_symlink()]
-    if not plain:
-        return
-    if _live_generation(out_dir, robot) is None:
-        gen = out_dir / f".{robot}.{secrets.token_hex(4)}.gen"
-        tmp = out_dir / f".{robot}.legacy"
-        _remove(tmp)
-        tmp.mkdir()
-        for path in plain:
-            if path.is_dir():
-                shutil.copytree(path, tmp / path.name, symlinks=True)
-            else:
-                shutil.copy2(path, tmp / path.name)
-        step("legacy_copied")
-        os.rename(tmp, gen)
-        _link(out_dir, robot, gen.name, _current(out_dir, robot))
-        step("legacy_current")
-    current = _current(out_dir, robot).name
-    if zip_path.exists() and not zip_path.is_symlink():
-        _link(out_dir, robot, f"{current}/{zip_path.name}", zip_path)
-        step("legacy_zip")
-    if kit.exists() and not kit.is_symlink():
-        tmp = out_dir / f".{robot}.{secrets.token_hex(4)}.tmp"
-        os.symlink(f"{current}/{kit.name}", tmp)
-        if not _exchange(tmp, kit):  # no renameat2: a short window without the folder
-            os.rename(kit, out_dir / f".{robot}.{secrets.token_hex(4)}.staging")
-            os.rename(tmp, kit)
-        step("legacy_kit")
-        _remove(tmp)
+def _unchanged(staged: Path, out_dir: Path, robot: str) -> bool:
+    """The staged kit, zip and manifest equal the published ones, byte for byte."""
+    kit, *single = _visible(out_dir, robot)
+    if not reuse.same_tree(staged / kit.name, kit):
+        return False
+    return all(
+        not path.is_symlink() and reuse.same_bytes(path, (staged / path.name).read_bytes())
+        for path in single
+    )
 
 
-def commit(staged: Path, out_dir: Path, robot: str) -> None:
-    """Publish the checked kit and zip in `staged` (call with the lock held)."""
+def commit(staged: Path, out_dir: Path, robot: str) -> bool:
+    """Publish the checked kit, zip and manifest in `staged` (call with the lock held).
+    Returns False when they equal the published ones: then nothing is written."""
     step("staged")
-    _adopt_legacy(out_dir, robot)
-    gen = staged.with_name(staged.name.removesuffix(".staging") + ".gen")
-    os.rename(staged, gen)
-    step("generation")
-    _link(out_dir, robot, gen.name, _current(out_dir, robot))
-    step("switched")
-    current = _current(out_dir, robot).name
-    for path in _visible(out_dir, robot):
-        want = f"{current}/{path.name}"
-        if not (path.is_symlink() and os.readlink(path) == want):
-            _link(out_dir, robot, want, path)
-    step("linked")
+    kit, _, _ = _visible(out_dir, robot)
+    if _unchanged(staged, out_dir, robot):
+        return False
+    if kit.is_dir() and not kit.is_symlink():
+        reuse.keep_folder_times(staged / kit.name, kit)
+    (staged / _INODE).write_text(str((staged / kit.name).stat().st_ino))
+    os.rename(staged, out_dir / manifest.journal_name(robot))
+    step("journaled")
+    _roll_forward(out_dir, robot)
     clean(out_dir, robot)
     step("cleaned")
+    return True
 
 
-def repair(out_dir: Path, robot: str) -> None:
-    """Finish what a killed build left (call with the lock held): the visible links of the
-    live generation, then `clean`."""
-    if _live_generation(out_dir, robot) is not None:
-        current = _current(out_dir, robot).name
-        for path in _visible(out_dir, robot):
-            if not path.exists() and not path.is_symlink():
-                _link(out_dir, robot, f"{current}/{path.name}", path)
+def _roll_forward(out_dir: Path, robot: str) -> bool:
+    """Finish the publish the journal `.NAME.commit` describes; every step checks whether it
+    already happened, so a rerun after a kill at any instant completes it. False when the
+    journal is damaged (its kit is gone): it is dropped, and the next commit republishes."""
+    journal = out_dir / manifest.journal_name(robot)
+    kit, zip_path, manifest_path = _visible(out_dir, robot)
+    try:
+        inode = int((journal / _INODE).read_text())
+    except (OSError, ValueError):
+        inode = -1
+    new = journal / kit.name
+    done = kit.is_dir() and not kit.is_symlink() and kit.stat().st_ino == inode
+    whole = done or (new.is_dir() and not new.is_symlink() and new.stat().st_ino == inode)
+    if whole and not done:
+        if not (kit.exists() or kit.is_symlink()):
+            os.rename(new, kit)  # a first build, or a kill between the two renames below
+        elif not _exchange(new, kit):
+            os.rename(kit, journal / _OLD_KIT)
+            step("kit_aside")
+            os.rename(new, kit)
+        step("kit_swapped")
+    for published, name in ((zip_path, "zip_moved"), (manifest_path, "manifest_moved")):
+        if whole and (journal / published.name).exists():
+            os.replace(journal / published.name, published)
+            step(name)
+    os.rename(journal, out_dir / f".{robot}.{secrets.token_hex(4)}.trash")
+    step("journal_closed")
+    return whole
+
+
+def repair(out_dir: Path, robot: str) -> str | None:
+    """Finish a publish a killed build left (call with the lock held) and remove what it
+    left; returns one line saying so, or None when there was none."""
+    journal = out_dir / manifest.journal_name(robot)
+    said = None
+    if journal.is_dir() and not journal.is_symlink():
+        kit = out_dir / layout.kit_dir_name(robot)
+        said = (
+            f"{kit}: the previous build was killed while publishing the kit and its zip "
+            "(they may come from different builds); "
+            + ("finished publishing it" if _roll_forward(out_dir, robot) else "republishing")
+        )
+    elif journal.is_symlink() or journal.exists():
+        _remove(journal)
     clean(out_dir, robot)
+    return said
+
+
+def clean(out_dir: Path, robot: str) -> None:
+    """Remove what an interrupted build of `robot` left (call with the lock held): staging
+    and trash folders and, once the kit is a plain folder, an earlier simkit's generations."""
+    for path in sorted(out_dir.glob(f".{robot}.*")):
+        if path.name.endswith((".staging", ".trash", ".tmp")):
+            _remove(path)
+    kit, zip_path, _ = _visible(out_dir, robot)
+    if kit.is_symlink() or zip_path.is_symlink():
+        return  # still the generation layout: its links point into .NAME.current
+    legacy = [out_dir / f".{robot}.current", out_dir / f".{robot}.legacy"]
+    legacy += sorted(out_dir.glob(f".{robot}.*.gen"))
+    legacy += [out_dir / f".{kit.name}.old", out_dir / f".{zip_path.name}.old"]
+    for path in legacy:
+        _remove(path)
 
 
 def recover_folder(final: Path) -> None:

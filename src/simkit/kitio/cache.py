@@ -1,27 +1,32 @@
-"""Content-addressed disk cache for slow pure steps (link solids, CoACD collision pieces).
+"""Content-addressed disk cache for slow pure steps (link solids, CoACD collision pieces),
+optionally in front of a shared remote store.
 
 Design notes (shared/DESIGN.md, "Cache"; issue 3): the key is the SHA-256 of the input bytes,
 the step's name and version, the library versions and every parameter, so a change to any of
 them misses instead of serving a stale result (onshape-to-robot keyed CoACD by file only).
-Entries are `.npz` files written with `allow_pickle=False` semantics (plain arrays, JSON as
-uint8 bytes), published atomically (`os.replace` of a temp file in the same folder), and carry
-a SHA-256 of their own content: a truncated, edited or unreadable entry is a miss, is deleted,
-and the step recomputes and rewrites it.
+Entries (entry.py) are `.npz` files of plain arrays, published atomically (`os.replace` of a
+temp file in the same folder), and carry their key and a SHA-256 of their content: a
+truncated, edited or unreadable entry is a miss, is deleted, and the step recomputes and
+rewrites it.
+
+Trust (issue 24; docs/scale-out.md): without `$SIMKIT_CACHE_KEY`, whoever can write the
+cache is trusted, as a plain digest can be recomputed. With it, entries carry an HMAC of
+their step, key and content, and an entry without a valid one is a miss. `readonly`
+(`--cache-readonly`, `$SIMKIT_CACHE_READONLY`) reads and never writes. Paths stored in
+entries are confined to their destination where they are written (confine.py).
 
 Location: `--cache-dir`, else `$SIMKIT_CACHE_DIR`, else the user cache folder (XDG on Linux,
-via platformdirs).
+via platformdirs); remote: `--remote-cache URL`, else `$SIMKIT_REMOTE_CACHE` (remote.py).
 """
 
 from __future__ import annotations
 
 import functools
 import hashlib
-import io
 import json
 import os
 import sys
 import tempfile
-import zipfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,10 +35,21 @@ from typing import TypeVar
 import numpy as np
 
 from simkit import __version__
+from simkit.errors import SimkitError
+from simkit.kitio.entry import ENV_SECRET, BadEntry, OldFormat, Unauthenticated, secret_from_env
+from simkit.kitio.entry import decode as decode_entry
+from simkit.kitio.entry import encode as encode_entry
+from simkit.kitio.remote import ENV_URL as ENV_REMOTE
+from simkit.kitio.remote import RemoteStore, is_url
+from simkit.kitio.values import code_digest
+from simkit.kitio.values import decode_json as decode_json
+from simkit.kitio.values import decode_plain as decode_plain
+from simkit.kitio.values import digest as digest
+from simkit.kitio.values import encode_json as encode_json
+from simkit.kitio.values import encode_plain as encode_plain
 
 ENV_DIR = "SIMKIT_CACHE_DIR"
-_DIGEST = "__sha256__"
-_KEY = "__key__"
+ENV_READONLY = "SIMKIT_CACHE_READONLY"
 
 Arrays = dict[str, np.ndarray]
 
@@ -106,49 +122,80 @@ def make_key(
     return h.hexdigest()
 
 
-def _content_digest(arrays: Arrays) -> str:
-    h = hashlib.sha256()
-    for name in sorted(arrays):
-        arr = np.ascontiguousarray(arrays[name])
-        h.update(f"{name}|{arr.dtype.str}|{arr.shape}|".encode())
-        h.update(arr.tobytes())
-    return h.hexdigest()
-
-
-def encode_json(value: object) -> np.ndarray:
-    """JSON data as a uint8 array, so metadata travels in the npz without pickle."""
-    return np.frombuffer(json.dumps(value).encode("utf-8"), dtype=np.uint8)
-
-
-def decode_json(arr: np.ndarray) -> object:
-    return json.loads(np.asarray(arr, dtype=np.uint8).tobytes().decode("utf-8"))
+def readonly_from_env() -> bool:
+    """`$SIMKIT_CACHE_READONLY` set to 1, true or yes."""
+    return os.environ.get(ENV_READONLY, "").strip().lower() in ("1", "true", "yes")
 
 
 @dataclass
 class Stats:
-    """Hits, misses and repaired (corrupt) entries per step, for tests and the bench."""
+    """Per step: local hits, remote hits, misses and repaired (bad) entries, in the order
+    the steps were first asked for; the build's summary line and tests read them."""
 
     hits: dict[str, int] = field(default_factory=dict)
     misses: dict[str, int] = field(default_factory=dict)
     repaired: dict[str, int] = field(default_factory=dict)
+    remote: dict[str, int] = field(default_factory=dict)
+    steps: list[str] = field(default_factory=list)
 
     def bump(self, table: dict[str, int], step: str) -> None:
         table[step] = table.get(step, 0) + 1
+        if step not in self.steps:
+            self.steps.append(step)
+
+    def summary(self) -> str:
+        """`step local/remote/miss, ...`, e.g. `link_solid 0/3/0, emit 0/1/0`."""
+        return ", ".join(
+            f"{s} {self.hits.get(s, 0)}/{self.remote.get(s, 0)}/{self.misses.get(s, 0)}"
+            for s in self.steps
+        )
 
 
 @dataclass
 class Cache:
-    """A cache folder; `enabled=False` (`--no-cache`) computes every step and stores nothing."""
+    """A cache folder, optionally in front of a remote store. `enabled=False`
+    (`--no-cache`) computes every step and stores nothing; `readonly` reads and never
+    writes (nor repairs); `secret` (`$SIMKIT_CACHE_KEY`) tags every entry written and
+    refuses entries without a valid tag (entry.py)."""
 
     root: Path | None
     enabled: bool = True
     stats: Stats = field(default_factory=Stats)
     warned: set[str] = field(default_factory=set)
+    readonly: bool = False
+    secret: bytes | None = None
+    remote: RemoteStore | None = None
+    #: (step, key) of remote entries that failed verification: the one overwrite allowed.
+    bad_remote: set[tuple[str, str]] = field(default_factory=set)
+    #: Where the last hit came from ("local" or "remote"), for `reject`.
+    last_source: str = ""
 
     @staticmethod
-    def at(root: Path | str | None = None, enabled: bool = True) -> Cache:
-        """The cache at `root` (default: env, then user cache folder)."""
-        return Cache(Path(root).expanduser() if root else default_dir(), enabled)
+    def at(
+        root: Path | str | None = None,
+        enabled: bool = True,
+        readonly: bool | None = None,
+        remote: str | None = None,
+    ) -> Cache:
+        """The cache at `root` (default: env, then user cache folder). `readonly` and
+        `remote` default to `$SIMKIT_CACHE_READONLY` and `$SIMKIT_REMOTE_CACHE`; the
+        secret is always `$SIMKIT_CACHE_KEY`. A URL as `root` is a one-line error."""
+        given = ("--cache-dir", str(root)) if root else (f"${ENV_DIR}", os.environ.get(ENV_DIR))
+        if given[1] and is_url(given[1]):
+            raise SimkitError(
+                f"{given[0]} {given[1]}: is a URL; the cache folder is local, give the URL "
+                "to --remote-cache (or $SIMKIT_REMOTE_CACHE)"
+            )
+        cache = Cache(
+            Path(root).expanduser() if root else default_dir(),
+            enabled,
+            readonly=readonly_from_env() if readonly is None else readonly,
+            secret=secret_from_env(),
+        )
+        url = os.environ.get(ENV_REMOTE, "") if remote is None else remote
+        if enabled and url:
+            cache.remote = RemoteStore(url, lambda m: cache._warn(m, "<remote>"))
+        return cache
 
     @staticmethod
     def disabled() -> Cache:
@@ -159,38 +206,102 @@ class Cache:
         return self.root / step / key[:2] / f"{key}.npz"
 
     def get(self, step: str, key: str) -> Arrays | None:
-        """The stored arrays, or None on a miss. An entry that is not a readable file holding
-        this key's arrays (corrupt, a folder, another key's content) is removed, counted as
-        repaired, and reported once with a one-line warning."""
+        """The stored arrays, or None on a miss: the local folder first, then the remote
+        store (a verified remote entry is copied into the local folder). An entry that is
+        not a readable file holding this key's arrays (corrupt, a folder, another key's
+        content) is removed, counted as repaired, and reported once with a one-line
+        warning; with a secret set, an untagged or mistagged entry is a miss with one
+        warning."""
         if not self.enabled:
             return None
+        found = self._local(step, key)
+        if found is not None:
+            self.stats.bump(self.stats.hits, step)
+            self.last_source = "local"
+            return found
+        found = self._fetch(step, key)
+        if found is not None:
+            self.stats.bump(self.stats.remote, step)
+            self.last_source = "remote"
+            return found
+        self.stats.bump(self.stats.misses, step)
+        return None
+
+    def _local(self, step: str, key: str) -> Arrays | None:
         path = self.path(step, key)
         try:
             present, plain = path.is_symlink() or path.exists(), path.is_file()
         except OSError:  # an unreadable cache folder: a miss
-            present = plain = False
-        if not present:
-            self.stats.bump(self.stats.misses, step)
             return None
-        arrays = None
+        if not present:
+            return None
         if plain and not path.is_symlink():
             try:
-                arrays = _decode(path.read_bytes(), key)
-            except OSError:
-                arrays = None
-            except _OldFormat:
-                self.stats.bump(self.stats.misses, step)
+                return self._verified(path.read_bytes(), step, key)
+            except (OSError, BadEntry):
+                pass
+            except (OldFormat, Unauthenticated):
                 return None  # `put` replaces it
-        if arrays is None:
-            self._repair(step, path)
-            self.stats.bump(self.stats.misses, step)
+        self._repair(step, path)
+        return None
+
+    def _verified(self, data: bytes, step: str, key: str) -> Arrays:
+        """`entry.decode`, warning once when a secret refuses an entry's tag."""
+        try:
+            return decode_entry(data, step, key, self.secret)
+        except Unauthenticated:
+            self._warn(
+                f"cache entries without a valid {ENV_SECRET} tag (written without the key, "
+                f"or forged) are recomputed; the first was a '{step}' entry",
+                "<tag>",
+            )
+            raise
+
+    def _fetch(self, step: str, key: str) -> Arrays | None:
+        """A verified entry from the remote store, copied into the local folder."""
+        if self.remote is None:
             return None
-        self.stats.bump(self.stats.hits, step)
+        data = self.remote.fetch(step, key)
+        if data is None:
+            return None
+        try:
+            arrays = self._verified(data, step, key)
+        except (BadEntry, OldFormat, Unauthenticated) as exc:
+            self.bad_remote.add((step, key))
+            if isinstance(exc, BadEntry):
+                self._warn(
+                    f"a '{step}' entry in the remote cache failed verification; recomputed",
+                    "<remote-bad>",
+                )
+            return None
+        if not self.readonly:
+            self._write_local(step, key, data)
         return arrays
 
+    def reject(self, step: str, key: str, exc: Exception) -> None:
+        """The entry `get` just returned cannot be used by its stage (it is well formed but
+        holds, e.g., a path that would leave the kit): a repaired miss with one warning,
+        and the remote copy may be replaced by the recomputed result."""
+        table = self.stats.remote if self.last_source == "remote" else self.stats.hits
+        table[step] -= 1
+        if not table[step]:
+            del table[step]
+        self.stats.bump(self.stats.misses, step)
+        self.bad_remote.add((step, key))
+        path = self.path(step, key)
+        if self.readonly or not path.is_file():
+            self.stats.bump(self.stats.repaired, step)
+            self._warn(f"a '{step}' cache entry was refused ({exc}); recomputed", step)
+        else:
+            self._repair(step, path)
+
     def _repair(self, step: str, path: Path) -> None:
-        """Remove a bad entry (file, link or folder) so the step rewrites it."""
+        """Remove a bad entry (file, link or folder) so the step rewrites it (not when
+        read-only: the entry is a miss and stays)."""
         self.stats.bump(self.stats.repaired, step)
+        if self.readonly:
+            self._warn(f"a '{step}' cache entry was unreadable or not its key's: {path}", step)
+            return
         try:
             if path.is_dir() and not path.is_symlink():
                 import shutil
@@ -212,18 +323,23 @@ class Cache:
             print(f"simkit: warning: {message}", file=sys.stderr)
 
     def put(self, step: str, key: str, arrays: Arrays) -> None:
-        """Store atomically: write a temp file beside the entry, then `os.replace` it. The
-        entry holds its key, inside its digest. A cache that cannot be written (read-only,
-        full) is a warning, never a failed build."""
+        """Store in the local folder and the remote store (nothing when read-only). The
+        entry holds its key inside its digest, and a tag when a secret is set. A cache that
+        cannot be written (read-only, full) is a warning, never a failed build."""
         if not self.enabled:
             return
-        payload = {name: np.ascontiguousarray(a) for name, a in arrays.items()}
-        if any(a.dtype.hasobject for a in payload.values()):
-            raise TypeError("cache entries hold plain arrays only (no pickled objects)")
-        payload[_KEY] = np.frombuffer(key.encode("ascii"), dtype=np.uint8)
-        payload[_DIGEST] = np.frombuffer(_content_digest(payload).encode("ascii"), dtype=np.uint8)
-        buf = io.BytesIO()
-        np.savez(buf, **payload)
+        data = encode_entry(step, key, arrays, self.secret)
+        if self.readonly:
+            return
+        self._write_local(step, key, data)
+        if self.remote is not None:
+            replace = (step, key) in self.bad_remote
+            self.remote.store(step, key, data, replace=replace)
+            self.bad_remote.discard((step, key))
+
+    def _write_local(self, step: str, key: str, data: bytes) -> None:
+        """Write a temp file beside the entry, then `os.replace` it: a full disk or a
+        killed build leaves no truncated entry."""
         path = self.path(step, key)
         tmp = None
         try:
@@ -232,13 +348,15 @@ class Cache:
                 self._repair(step, path)
             fd, tmp = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".tmp", dir=path.parent)
             with os.fdopen(fd, "wb") as handle:
-                handle.write(buf.getvalue())
+                handle.write(data)
             os.replace(tmp, path)
+            tmp = None
         except OSError as exc:
-            if tmp is not None:
-                Path(tmp).unlink(missing_ok=True)
             why = f"cache folder {self.root} is not writable ({exc.strerror}); results not cached"
             self._warn(why, "<write>")
+        finally:  # on every way out, an interrupt included: no temp file left
+            if tmp is not None:
+                Path(tmp).unlink(missing_ok=True)
 
     def memo(self, step: str, key: str, compute: Callable[[], Arrays]) -> Arrays:
         """`get`, else `compute` and `put`."""
@@ -250,95 +368,9 @@ class Cache:
         return result
 
 
-def _decode(data: bytes, key: str) -> Arrays | None:
-    """Arrays of an entry, or None when it is unreadable, its digest does not match, or it
-    holds another key's content (entries are bound to their key)."""
-    try:
-        with np.load(io.BytesIO(data), allow_pickle=False) as npz:
-            if not isinstance(npz, np.lib.npyio.NpzFile):
-                return None
-            arrays = {name: npz[name] for name in npz.files}
-    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, RuntimeError):
-        return None
-    stored = arrays.pop(_DIGEST, None)
-    if stored is None or stored.tobytes().decode("ascii", "replace") != _content_digest(arrays):
-        return None
-    bound = arrays.pop(_KEY, None)
-    if bound is None:  # written before entries held their key: an old format, not damage
-        raise _OldFormat
-    if bound.tobytes() != key.encode("ascii"):
-        return None
-    return arrays
-
-
-class _OldFormat(Exception):
-    """An intact entry from a simkit that did not store keys: a silent miss."""
-
-
-# --- whole-robot derive steps -----------------------------------------------------------
-
-
-def code_digest() -> str:
-    """SHA-256 of simkit's own source files: the version of a robot-level step, so editing
-    any module (a step or what it calls) invalidates its cached results."""
-    global _CODE_DIGEST
-    if _CODE_DIGEST is None:
-        package = Path(__file__).resolve().parents[1]  # every module of simkit
-        h = hashlib.sha256(__version__.encode())
-        for path in sorted(package.rglob("*.py")):
-            h.update(path.relative_to(package).as_posix().encode())
-            h.update(path.read_bytes())
-        _CODE_DIGEST = h.hexdigest()
-    return _CODE_DIGEST
-
-
-_CODE_DIGEST: str | None = None
-
-
-def digest(value: object) -> str:
-    """SHA-256 of a value's content: dataclasses by field, pydantic models by dump, arrays by
-    bytes, floats by repr, numpy scalars as the Python numbers they equal (a cached step
-    returns `float` where a computed one returned `np.float64`: both must give one key, or
-    the first rebuild after a cold build misses). Used to key a step on the whole `Robot`."""
-    from dataclasses import fields, is_dataclass
-
-    h = hashlib.sha256()
-
-    def feed(v: object) -> None:
-        if is_dataclass(v) and not isinstance(v, type):
-            h.update(f"<{type(v).__name__}".encode())
-            for f in fields(v):
-                h.update(f.name.encode())
-                feed(getattr(v, f.name))
-            h.update(b">")
-        elif hasattr(v, "model_dump"):
-            feed(v.model_dump())  # type: ignore[union-attr]
-        elif isinstance(v, np.generic):  # a numpy scalar is its value: JSON round trips agree
-            feed(v.item())
-        elif isinstance(v, np.ndarray):
-            h.update(f"a{v.dtype.str}{v.shape}".encode())
-            h.update(np.ascontiguousarray(v).tobytes())
-        elif isinstance(v, Mapping):
-            h.update(b"{")
-            for k in sorted(v, key=str):
-                feed(str(k))
-                feed(v[k])
-            h.update(b"}")
-        elif isinstance(v, (list, tuple)):
-            h.update(b"[" if isinstance(v, list) else b"(")
-            for item in v:
-                feed(item)
-            h.update(b"]")
-        elif isinstance(v, np.generic) and not isinstance(v, np.ndarray):
-            feed(v.item())  # a numpy scalar digests as the Python number it equals
-        else:
-            h.update(f"{type(v).__name__}:{v!r};".encode())
-
-    feed(value)
-    return h.hexdigest()
-
-
 T = TypeVar("T")
+#: What a stage's `decode` raises on an entry it cannot use (confine.UnsafePath included).
+_UNUSABLE = (KeyError, IndexError, TypeError, ValueError, UnicodeDecodeError)
 
 
 def cached_stage(
@@ -361,7 +393,10 @@ def cached_stage(
     key = make_key(step, 1, [code_digest().encode(), *inputs], params or {}, libraries)
     found = cache.get(step, key)
     if found is not None:
-        return decode(found)
+        try:
+            return decode(found)
+        except _UNUSABLE as exc:  # verified bytes the stage cannot use, e.g. a stored `../`
+            cache.reject(step, key, exc)
     value = compute()
     arrays = encode(value)
     if arrays is None:
@@ -372,64 +407,6 @@ def cached_stage(
     return decode(arrays)
 
 
-def encode_plain(value: object) -> Arrays | None:
-    """Plain data (dicts with str keys, lists, str, bool, int, float64, numpy arrays) as
-    cache arrays: a JSON skeleton plus one array per ndarray. None for anything JSON cannot
-    hold exactly (tuples, other objects), so such a value is simply not cached."""
-    arrays: Arrays = {}
-    try:
-        skeleton = _split(value, arrays)
-        if json.loads(json.dumps(skeleton)) != skeleton:
-            return None
-    except (TypeError, ValueError):
-        return None
-    return {"skeleton": encode_json(skeleton), **arrays}
-
-
-def decode_plain(arrays: Arrays) -> object:
-    """The value `encode_plain` stored."""
-    return _join(decode_json(arrays["skeleton"]), arrays)
-
-
 def library_versions(names: tuple[str, ...]) -> dict[str, str | None]:
     """Installed version of each distribution, None when absent (robot.json provenance)."""
     return {name: _installed(name) for name in names}
-
-
-_ARRAY = "__ndarray__"
-
-
-def _split(value: object, arrays: Arrays) -> object:
-    """JSON skeleton of `value` with each numpy array moved into `arrays` (raises TypeError
-    for anything JSON cannot hold exactly, such as tuples)."""
-    if isinstance(value, np.ndarray):
-        if value.dtype.hasobject:
-            raise TypeError("object array")
-        name = f"a{len(arrays)}"
-        arrays[name] = value
-        return {_ARRAY: name}
-    if isinstance(value, dict):
-        if not all(isinstance(k, str) for k in value) or _ARRAY in value:
-            raise TypeError("keys")
-        return {k: _split(v, arrays) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_split(v, arrays) for v in value]
-    if value is None or type(value) in (bool, int, float, str):
-        return value
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating) and value.dtype == np.float64:
-        return float(value)  # the same double; emitters format both alike
-    raise TypeError(type(value).__name__)
-
-
-def _join(value: object, arrays: Mapping[str, np.ndarray]) -> object:
-    if isinstance(value, dict):
-        if set(value) == {_ARRAY}:
-            return arrays[value[_ARRAY]]
-        return {k: _join(v, arrays) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_join(v, arrays) for v in value]
-    return value

@@ -53,7 +53,8 @@ def visual_mesh(link: str) -> str:
 
 
 def collision_mesh(link: str, index: int) -> str:
-    return f"meshes/collision/{link}_{index:02d}.stl"
+    """A convex collision piece, OBJ (kitio/obj.py): Drake's SceneGraph needs OBJ for hulls."""
+    return f"meshes/collision/{link}_{index:02d}.obj"
 
 
 def benchmark(robot: str, ext: str) -> str:
@@ -98,6 +99,11 @@ def freefall_plot() -> str:
 def relative(from_file: str, to_file: str) -> str:
     """Path of `to_file` as seen from the folder of `from_file` (e.g. `../meshes/...`)."""
     return posixpath.relpath(to_file, posixpath.dirname(from_file) or ".")
+
+
+def sdf(robot: str) -> str:
+    """The SDFormat 1.9 model (emit/sdf.py), for Gazebo and Drake."""
+    return f"sdf/{robot}.sdf"
 
 
 def step(robot: str) -> str:

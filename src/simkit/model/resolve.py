@@ -219,4 +219,6 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         ros2_control=spec.ros2_control,
         urdf_blocks=spec.urdf_blocks,
         freefall=spec.freefall,
+        maintainer=(spec.maintainer.name, spec.maintainer.email) if spec.maintainer else None,
+        license=spec.license,
     )

@@ -197,15 +197,26 @@ class Tree:
         return np.linalg.solve(self.mass_matrix(q, poses), passive - h)
 
 
-def integrate(robot: Robot, q0, duration: float, times: np.ndarray) -> np.ndarray:
+class EvaluationBudget(RuntimeError):
+    """The integration needed more dynamics evaluations than its budget (a stiff setup)."""
+
+
+def integrate(
+    robot: Robot, q0, duration: float, times: np.ndarray, max_evals: int | None = None
+) -> np.ndarray:
     """Joint positions at `times` (s) after release from rest at q0: solve_ivp (DOP853,
-    rtol RTOL, atol ATOL). Returns shape (len(times), n_dof)."""
+    rtol RTOL, atol ATOL), raising EvaluationBudget after `max_evals` evaluations of the
+    dynamics. Returns shape (len(times), n_dof)."""
     from scipy.integrate import solve_ivp  # lazy: scipy is only needed here
 
     tree = Tree.of(robot)
     n = len(tree.names)
+    evals = [0]
 
     def rhs(_t, state):
+        evals[0] += 1
+        if max_evals is not None and evals[0] > max_evals:
+            raise EvaluationBudget(f"more than {max_evals} dynamics evaluations")
         q, qd = state[:n], state[n:]
         return np.concatenate([qd, tree.acceleration(q, qd)])
 

@@ -281,6 +281,9 @@ class Robot:
     #: URDF elements carried over verbatim (spec `urdf_blocks`: an import's gazebo,
     #: transmission and ros2_control blocks), as XML text
     urdf_blocks: tuple[str, ...] = ()
+    #: package.xml: the spec's maintainer (name, email) and licence, or None (ros2.py defaults)
+    maintainer: tuple[str, str] | None = None
+    license: str | None = None
 
     def link(self, name: str) -> Link:
         for link in self.links:

@@ -18,7 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.diff import TITLES, Change, Report, delta_text, value_text
+from simkit.diff import Change, Report
+from simkit.diff_text import TITLES, cells, no_change, summary
+from simkit.errors import SimkitError
 from simkit.review.png import png_bytes, read_png
 from simkit.review.progress import Reporter
 from simkit.review.render import DEFAULT_SIZE, Item, kit_poses, run_job
@@ -124,6 +126,7 @@ def _img(data: bytes | None, alt: str) -> str:
 
 
 def _changes_html(changes: Sequence[Change]) -> list[str]:
+    """One table per kind of change; every cell filled (`diff_text.cells`)."""
     out = []
     for kind, title in TITLES.items():
         items = [c for c in changes if c.kind == kind]
@@ -131,20 +134,10 @@ def _changes_html(changes: Sequence[Change]) -> list[str]:
             continue
         out.append(f"<h3>{html.escape(title)}</h3>")
         rows = ["<tr><th>name</th><th>field</th><th>old</th><th>new</th><th>change</th></tr>"]
-        for c in items:
-            if c.change != "modified" or kind == "robot_json":
-                cells = [c.name, c.field, "", "", "changed" if c.change == "modified" else c.change]
-            else:
-                cells = [
-                    c.name,
-                    c.field,
-                    value_text(c.old, c.unit, c.field),
-                    value_text(c.new, c.unit, c.field),
-                    delta_text(c),
-                ]
-            rows.append(
-                "<tr>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in cells) + "</tr>"
-            )
+        rows += [
+            "<tr>" + "".join(f"<td>{html.escape(v)}</td>" for v in cells(c)) + "</tr>"
+            for c in items
+        ]
         out.append("<table>" + "".join(rows) + "</table>")
     return out
 
@@ -161,12 +154,9 @@ def to_html(report: Report, rows: Sequence[Row]) -> str:
         f"NEW <code>{esc(report.new)}</code></p>",
     ]
     if report.equal:
-        parts.append("<p>No changes: every file is byte-identical.</p>")
+        parts.append(f"<p>{esc(no_change(report))}</p>")
     else:
-        parts.append(
-            f"<p>{len(report.changes)} semantic change(s); files: {len(report.added)} added, "
-            f"{len(report.removed)} removed, {len(report.changed)} changed.</p>"
-        )
+        parts.append(f"<p>{esc(summary(report))}</p>")
     parts += ["<h2>Changes</h2>", *_changes_html(report.changes)]
     files = [
         (label, paths)
@@ -174,6 +164,8 @@ def to_html(report: Report, rows: Sequence[Row]) -> str:
             ("added", report.added),
             ("removed", report.removed),
             ("changed", report.changed),
+            ("round-off only", report.round_off),
+            ("provenance", report.metadata),
         )
         if paths
     ]
@@ -196,7 +188,7 @@ def to_html(report: Report, rows: Sequence[Row]) -> str:
             f'<tr><th>{esc(row.title)}<br><span class="note">{note}</span></th>'
             + _img(row.old, f"OLD {row.title}")
             + _img(row.new, f"NEW {row.title}")
-            + (_img(row.diff, f"difference {row.title}") if row.diff else "<td></td>")
+            + (_img(row.diff, f"difference {row.title}") if row.diff else '<td class="note">-</td>')
             + "</tr>"
         )
     parts += ["</table>", "</body></html>", ""]
@@ -211,10 +203,25 @@ def write_report(
     size: tuple[int, int] = DEFAULT_SIZE,
     progress: Reporter | None = None,
 ) -> Path:
-    """Render, compose and write the HTML report to `out` (written only when complete)."""
-    text = to_html(report, render_rows(old, new, report, size, progress))
-    out.parent.mkdir(parents=True, exist_ok=True)
+    """Render, compose and write the HTML report to `out` (written only when complete; an
+    output that cannot be created is one line naming it, before anything is rendered)."""
     tmp = out.with_name(out.name + ".part")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(out)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp.write_bytes(b"")
+    except OSError as exc:
+        raise SimkitError(f"{out}: cannot write the report ({_why(exc)})") from None
+    try:
+        text = to_html(report, render_rows(old, new, report, size, progress))
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(out)
+    except OSError as exc:
+        raise SimkitError(f"{out}: cannot write the report ({_why(exc)})") from None
+    finally:
+        tmp.unlink(missing_ok=True)
     return out
+
+
+def _why(exc: OSError) -> str:
+    """The OS's reason, with the path it concerns: `NAME: File exists`."""
+    return f"{exc.filename}: {exc.strerror}" if exc.filename and exc.strerror else str(exc)

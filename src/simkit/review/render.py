@@ -1,6 +1,7 @@
 """`simkit render KIT|ZIP --out DIR`: one PNG per named pose, drawn by MuJoCo's offscreen
 renderer from the kit's MJCF (floor, two lights, the kit's materials, a camera framing the
-whole robot in every pose; `--collision` adds the collision geometry, translucent).
+robot in each pose, its fixtures only near it; `--collision` adds the collision geometry,
+translucent).
 
 Headless: the render process (`render_worker`) runs with `MUJOCO_GL=egl`, and when EGL gives
 no context, with `MUJOCO_GL=osmesa` (Debian's `libosmesa6`). A `MUJOCO_GL` of egl or osmesa in
@@ -114,8 +115,9 @@ def run_job(
     camera: Camera = DEFAULT_CAMERA,
     on_image: OnImage | None = None,
 ) -> dict:
-    """Render `items` in one process, with one camera fitted to all `kits`. Returns the
-    camera (`camera`, a Camera) and each kit's collision geometry hash (`collision`)."""
+    """Render `items` in one process, with one camera per pose fitted to all `kits` in that
+    pose. Returns the cameras (`cameras`, pose -> Camera) and each kit's collision geometry
+    hash (`collision`)."""
     job = {
         "kits": [str(k) for k in kits],
         "size": list(size),
@@ -126,7 +128,8 @@ def run_job(
         ],
     }
     _backend, result = _first_working(job, on_image)
-    return {"camera": Camera.from_json(result["camera"]), "collision": result["collision"]}
+    cameras = {pose: Camera.from_json(doc) for pose, doc in result["cameras"].items()}
+    return {"cameras": cameras, "collision": result["collision"]}
 
 
 def kit_poses(kit: Path) -> dict[str, list[float]]:
@@ -146,7 +149,7 @@ def render_kit(
     on_image: OnImage | None = None,
 ) -> list[Path]:
     """`out_dir/<pose>.png` for each pose (default: every named pose). Files appear only when
-    every image rendered; the camera frames the robot in all named poses, whichever are drawn."""
+    every image rendered; each pose's camera frames the robot in that pose."""
     known = kit_poses(kit)
     wanted = list(poses) if poses else list(known)
     missing = [p for p in wanted if p not in known]

@@ -3,7 +3,8 @@ its named poses as MuJoCo `qpos`, and a camera that frames the whole robot.
 
 Frames: the kit's world frame (Z up, metres). The camera is MuJoCo's free camera: azimuth
 and elevation in degrees, distance in metres from `lookat`. Framing uses the robot's geometry
-in every named pose, so all poses of a kit (and both kits of a diff) share one camera.
+in every named pose, so all poses of a kit (and both kits of a diff) share one camera; fixtures
+(links welded to the world) count only near the moving links (`framing_points`).
 """
 
 from __future__ import annotations
@@ -36,14 +37,19 @@ COLLISION_COLOURS = (
 COLLISION_ALPHA, VISUAL_FAINT = 0.55, 0.25
 #: the fitted distance leaves this much room around the robot (all named poses).
 MARGIN = 1.15
+#: framing: fixtures (geometry welded to the world: a wall plate, a pedestal) count only
+#: within this fraction of the moving links' extent around them, so the robot fills the frame
+FIXTURE_ROOM = 0.1
 POSE_NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
 
+#: a dark blue-grey floor and backdrop, so white, grey and coloured robots all stand out
+#: (issue 25: a white robot on a light floor had low contrast)
 SCENE_ASSETS = """
 <asset>
   <texture name="simkit_render_sky" type="skybox" builtin="gradient" width="64" height="384"
-    rgb1="0.97 0.98 1" rgb2="0.8 0.84 0.9" />
+    rgb1="0.26 0.3 0.36" rgb2="0.12 0.14 0.18" />
   <texture name="simkit_render_floor" type="2d" builtin="checker" width="256" height="256"
-    rgb1="0.86 0.87 0.89" rgb2="0.78 0.79 0.82" mark="edge" markrgb="0.7 0.71 0.74" />
+    rgb1="0.2 0.25 0.32" rgb2="0.16 0.2 0.26" mark="edge" markrgb="0.26 0.31 0.38" />
   <material name="simkit_render_floor" texture="simkit_render_floor" texrepeat="4 4"
     texuniform="true" reflectance="0" />
 </asset>
@@ -212,30 +218,64 @@ def pose_qpos(scene: KitScene, pose: str) -> np.ndarray:
     return qpos
 
 
-def robot_points(scene: KitScene, data) -> np.ndarray:
-    """World-frame points (m) of the robot's visual and collision geoms in every named pose:
-    mesh vertices exactly, other shapes by the corners of their bounding spheres' boxes."""
+def _geom_points(model, data, geom: int) -> np.ndarray:
+    """World-frame points (m) of one geom: mesh vertices exactly, other shapes by the corners
+    of their bounding spheres' boxes."""
+    import mujoco
+
+    mesh = model.geom_dataid[geom]
+    if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_MESH and mesh >= 0:
+        start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+        local = model.mesh_vert[start : start + count]
+        rot = data.geom_xmat[geom].reshape(3, 3)
+        return local @ rot.T + data.geom_xpos[geom]
+    r = model.geom_rbound[geom]
+    corners = np.array(np.meshgrid(*[(-r, r)] * 3)).reshape(3, -1).T
+    return data.geom_xpos[geom] + corners
+
+
+def posed_points(
+    scene: KitScene, data, poses: list[str] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(points, moving): world-frame points (m) of the robot's visual and collision geoms in
+    `poses` (default: every named pose), and for each whether it belongs to a moving link (a
+    body not welded to the world; fixtures such as a wall plate or a pedestal are welded)."""
     import mujoco
 
     model = scene.model
-    points = []
-    for pose in scene.poses:
+    points, moving = [], []
+    for pose in scene.poses if poses is None else poses:
         data.qpos[:] = pose_qpos(scene, pose)
         mujoco.mj_kinematics(model, data)
         for geom in range(model.ngeom):
             if model.geom_group[geom] in (FLOOR_GROUP, HIDDEN_GROUP):
                 continue
-            mesh = model.geom_dataid[geom]
-            if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_MESH and mesh >= 0:
-                start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
-                local = model.mesh_vert[start : start + count]
-                rot = data.geom_xmat[geom].reshape(3, 3)
-                points.append(local @ rot.T + data.geom_xpos[geom])
-            else:
-                r = model.geom_rbound[geom]
-                corners = np.array(np.meshgrid(*[(-r, r)] * 3)).reshape(3, -1).T
-                points.append(data.geom_xpos[geom] + corners)
-    return np.concatenate(points) if points else np.zeros((1, 3))
+            found = _geom_points(model, data, geom)
+            points.append(found)
+            welded = model.body_weldid[model.geom_bodyid[geom]] == 0
+            moving.append(np.full(len(found), not welded))
+    if not points:
+        return np.zeros((1, 3)), np.ones(1, dtype=bool)
+    return np.concatenate(points), np.concatenate(moving)
+
+
+def robot_points(scene: KitScene, data) -> np.ndarray:
+    """World-frame points (m) of the robot's visual and collision geoms in every named pose."""
+    return posed_points(scene, data)[0]
+
+
+def framing_points(points: np.ndarray, moving: np.ndarray) -> np.ndarray:
+    """The points a camera frames: the moving links, and of the fixtures only the points
+    within FIXTURE_ROOM of the moving links' extent around their bounding box, so that a 1 m
+    wall plate does not shrink a 0.3 m arm to a corner of the picture (issue 25). Without
+    moving links (a kit of fixed links only), every point counts."""
+    if not moving.any():
+        return points
+    lo, hi = points[moving].min(axis=0), points[moving].max(axis=0)
+    room = FIXTURE_ROOM * (hi - lo).max()
+    fixed = points[~moving]
+    near = np.all((fixed >= lo - room) & (fixed <= hi + room), axis=1)
+    return np.concatenate([points[moving], fixed[near]])
 
 
 def collision_colours(scene: KitScene, on: bool) -> None:
@@ -306,3 +346,37 @@ def fit_camera(camera: Camera, points: np.ndarray, fovy_deg: float, aspect: floa
     need = np.maximum(np.abs(v @ right) / tan_h, np.abs(v @ up) / tan_v) - v @ forward
     distance = camera.distance or MARGIN * max(float(need.max()), 1e-2)
     return Camera(camera.azimuth, camera.elevation, distance, tuple(float(c) for c in centre))
+
+
+def _ray_floor(origin: np.ndarray, ray: np.ndarray, floor_z: float) -> np.ndarray | None:
+    if ray[2] >= -1e-9:
+        return None  # parallel to the floor or upward: the ray never reaches it
+    return origin + ray * (floor_z - origin[2]) / ray[2]
+
+
+def shadow_clip(
+    camera: Camera,
+    fovy_deg: float,
+    aspect: float,
+    points: np.ndarray,
+    floor_z: float,
+    centre: np.ndarray,
+    light_dir: np.ndarray,
+) -> float:
+    """Half-width (m) of a directional light's shadow box about `centre` that covers the robot
+    and the floor in view up to the image's bottom corners. MuJoCo's shadow map (an
+    orthographic box of half-width `vis.map.shadowclip` times the extent) speckles the floor
+    outside it (shadow acne: rosie_1400's 780 dark pixels per image, issue 25)."""
+    forward, right, up = _basis(camera.azimuth, camera.elevation)
+    eye = np.asarray(camera.lookat, dtype=float) - camera.distance * forward
+    tan_v = math.tan(math.radians(fovy_deg) / 2)
+    tan_h = tan_v * aspect
+    seen = [points]
+    for sx in (-1.0, 0.0, 1.0):
+        hit = _ray_floor(eye, forward + sx * tan_h * right - tan_v * up, floor_z)
+        if hit is not None:
+            seen.append(hit[None, :])
+    d = np.concatenate(seen) - centre
+    light = np.asarray(light_dir, dtype=float) / np.linalg.norm(light_dir)
+    across = d - np.outer(d @ light, light)  # offsets across the light's view
+    return float(np.linalg.norm(across, axis=1).max())

@@ -3,7 +3,8 @@
 The page (`web/index.html`, `web/viewer.js`) and a pinned three.js (`web/vendor/three/`, MIT)
 come from the simkit package; everything else from the kit folder (or a kit zip, unpacked to a
 temporary folder): robot.json for joints, limits, named poses and frames, the GLB, and
-`meshes/collision/*.stl` for the collision pieces (the GLB holds the visual geometry only).
+`meshes/collision/*.obj` (older kits: `.stl`) for the collision pieces (the GLB holds the
+visual geometry only).
 No request leaves the machine. URL layout: `/` the page, `/vendor/...` three.js,
 `/kit/PATH` a kit file, `/kit-files.json` the sorted list of kit files.
 """
@@ -30,15 +31,26 @@ TYPES = {
     ".json": "application/json",
     ".glb": "model/gltf-binary",
     ".stl": "model/stl",
+    ".obj": "model/obj",
     ".png": "image/png",
 }
 
 
+#: characters: longer URL paths are answered 404 without touching the file system
+MAX_PATH = 1024
+
+
 def _inside(root: Path, rel: str) -> Path | None:
-    """`root/rel` if it is a file inside root (no `..` escapes), else None."""
-    path = (root / rel).resolve()
-    if path.is_file() and path.is_relative_to(root.resolve()):
-        return path
+    """`root/rel` if it is a file inside root (no `..` escapes), else None. A path the file
+    system refuses (too long, a name over 255 bytes) is not found either."""
+    if len(rel) > MAX_PATH:
+        return None
+    try:
+        path = (root / rel).resolve()
+        if path.is_file() and path.is_relative_to(root.resolve()):
+            return path
+    except (OSError, ValueError):  # ENAMETOOLONG, ELOOP, ...
+        return None
     return None
 
 
@@ -69,7 +81,12 @@ def make_handler(kit: Path) -> type[BaseHTTPRequestHandler]:
                 self.wfile.write(body)
 
         def _serve(self, head: bool) -> None:
-            path = unquote(urlsplit(self.path).path)
+            try:
+                path = unquote(urlsplit(self.path).path, errors="strict")
+            except (UnicodeDecodeError, ValueError):
+                return self.send_error(HTTPStatus.BAD_REQUEST, "malformed URL")
+            if any(ord(c) < 32 or ord(c) == 127 for c in path):  # %00, %0a, ...
+                return self.send_error(HTTPStatus.BAD_REQUEST, "control character in URL")
             if path == "/kit-files.json":
                 body = json.dumps(kit_files(kit)).encode()
                 return self._send(body, TYPES[".json"], head)
@@ -105,9 +122,18 @@ def start_server(kit: Path, port: int = 0) -> ThreadingHTTPServer:
 
 
 def _unzip(path: Path, into: Path) -> Path:
+    """Write a kit zip's files under `into`; a zip holding a file and a folder of one name
+    (`a` and `a/b`) is refused in one line, before anything is written."""
     from simkit.diff import load_kit
 
-    for name, data in load_kit(path).items():
+    files = load_kit(path)
+    folders = {
+        "/".join(name.split("/")[:i]) for name in files for i in range(1, name.count("/") + 1)
+    }
+    clash = sorted(folders & set(files))
+    if clash:
+        raise SimkitError(f"{path}: '{clash[0]}' is both a file and a folder in the zip")
+    for name, data in files.items():
         target = into / name
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_bytes(data)

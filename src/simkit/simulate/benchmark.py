@@ -115,4 +115,5 @@ def mesh_assets(kit_dir: Path) -> dict[str, bytes]:
     """The kit's mesh files keyed by their path under `meshes/` (the MJCF's meshdir), so the
     MJCF compiles from a string with its collision geometry."""
     meshes = kit_dir / "meshes"
-    return {f.relative_to(meshes).as_posix(): f.read_bytes() for f in sorted(meshes.rglob("*.stl"))}
+    files = sorted(f for f in meshes.rglob("*") if f.suffix in (".stl", ".obj"))
+    return {f.relative_to(meshes).as_posix(): f.read_bytes() for f in files}

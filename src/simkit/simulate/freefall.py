@@ -43,6 +43,12 @@ SAMPLE_DT = 0.01  # s: trajectories are compared, stored and plotted every 10 ms
 RUNS = ("rigid", "friction")
 SIDES = ("independent", "mjcf", "urdf")
 PAIRS = (("mjcf", "independent"), ("urdf", "independent"), ("mjcf", "urdf"))
+#: dynamics evaluations per independent run: ecn_2r's 2 s swing takes about 3,900 (0.5 ms
+#: each); joint friction of 10 N m makes the regularised Coulomb term stiff and takes 690,000
+#: (250 s), so the budget refuses such a setup within about 20 s
+MAX_EVALS = 40_000
+#: MuJoCo RK4 steps per run (duration / timestep): 2 s at ecn_2r's 1 ms is 2,000
+MAX_MUJOCO_STEPS = 200_000
 
 
 def sample_times(duration: float) -> np.ndarray:
@@ -103,12 +109,39 @@ def _frictionless(robot: Robot) -> Robot:
     return replace(robot, joints=tuple(replace(j, friction=0.0) for j in robot.joints))
 
 
+def _budget(spec_file: str, duration: float, timestep: float) -> None:
+    """Refuse, before any step, a MuJoCo run longer than MAX_MUJOCO_STEPS."""
+    if duration / timestep > MAX_MUJOCO_STEPS:
+        raise SpecError(
+            spec_file,
+            None,
+            "freefall.duration",
+            f"{duration:g} s at a {timestep:g} s timestep is more than the free-fall budget of "
+            f"{MAX_MUJOCO_STEPS} steps per run",
+        )
+
+
+def _integrate(robot: Robot, q0, duration: float, times: np.ndarray, run: str) -> np.ndarray:
+    try:
+        return rnea.integrate(robot, q0, duration, times, max_evals=MAX_EVALS)
+    except rnea.EvaluationBudget:
+        friction = max((j.friction for j in robot.movable_joints), default=0.0)
+        raise SpecError(
+            robot.spec_file,
+            None,
+            "freefall",
+            f"the independent free-fall integration ({run} run) needs more than its budget "
+            f"of {MAX_EVALS} dynamics evaluations (a stiff setup: joint friction up to "
+            f"{friction:g} N m); lower the friction or shorten freefall.duration",
+        ) from None
+
+
 def _independent(robot: Robot, q0, duration: float) -> dict[str, np.ndarray]:
     """Both runs of the independent integration, checked against the joint limits."""
     times = sample_times(duration)
     out = {
-        "rigid": rnea.integrate(_frictionless(robot), q0, duration, times),
-        "friction": rnea.integrate(robot, q0, duration, times),
+        "rigid": _integrate(_frictionless(robot), q0, duration, times, "rigid"),
+        "friction": _integrate(robot, q0, duration, times, "friction"),
     }
     for run, traj in out.items():
         for k, joint in enumerate(robot.movable_joints):
@@ -130,7 +163,7 @@ def _independent(robot: Robot, q0, duration: float) -> dict[str, np.ndarray]:
 
 
 def mujoco_runs(
-    mjcf: Path, urdf: Path, joints: Joints, q0, duration: float
+    mjcf: Path, urdf: Path, joints: Joints, q0, duration: float, spec_file: str = ""
 ) -> tuple[dict, float, dict]:
     """MuJoCo trajectories {run: {"mjcf": Q, "urdf": Q}}, the timestep used (the MJCF's), and
     the MJCF's own integrator name and rigid-run trajectory (informational)."""
@@ -138,6 +171,7 @@ def mujoco_runs(
 
     names = [name for name, _ in joints]
     timestep = float(load_mjcf_file(mjcf).opt.timestep)
+    _budget(spec_file or str(mjcf), duration, timestep)
     runs: dict = {}
     for run in RUNS:
         models = load_models(mjcf, urdf, joints)
@@ -184,6 +218,7 @@ def run(kit_dir: Path, robot: Robot) -> dict | None:
         joints,
         q0,
         setup.duration,
+        robot.spec_file,
     )
     trajectories = {run: {"independent": independent[run], **runs[run]} for run in RUNS}
     numbers = figures(trajectories)

@@ -37,6 +37,9 @@ class SourceDoc:
 MAX_DEPTH = 48
 MAX_NODES = 200_000
 MAX_BYTES = 4_000_000
+#: a longer integer overflows float() (the bounds check would raise); shorter ones get the
+#: bounds' own message ("at most ...")
+MAX_INT_DIGITS = 308
 _TAGS = {
     f"tag:yaml.org,2002:{name}"
     for name in ("str", "int", "float", "bool", "null", "map", "seq", "timestamp")
@@ -79,6 +82,8 @@ def _walk(
                     ".".join(map(str, loc)) or "<root>",
                     f"keys must be strings, got {key!r}",
                 )
+            if not key.isprintable():
+                raise _refuse(key_node, loc, f"key {key!r} is not one line of printable text")
             if key in out:
                 raise SpecError(
                     "", key_node.start_mark.line + 1, _dotted((*loc, key)), "duplicate key"
@@ -89,6 +94,10 @@ def _walk(
         return out
     if isinstance(node, yaml.SequenceNode):
         return [_walk(child, (*loc, i), lines, stack, count) for i, child in enumerate(node.value)]
+    digits = sum(c.isdigit() for c in str(node.value)) if node.tag.endswith(":int") else 0
+    if digits > MAX_INT_DIGITS:
+        why = f"an integer of {digits} digits (at most {MAX_INT_DIGITS}) is beyond any number"
+        raise _refuse(node, loc, why)
     try:
         return _CONSTRUCTOR.construct_object(node, deep=True)
     except (yaml.YAMLError, ValueError, OverflowError) as exc:
@@ -99,7 +108,8 @@ def _dotted(loc: Loc) -> str:
     """`('links', 3, 'mass')` -> `links[3].mass`."""
     out = ""
     for part in loc:
-        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+        text = part if isinstance(part, int) or part.isprintable() else repr(part)
+        out += f"[{text}]" if isinstance(part, int) else (f".{text}" if out else str(text))
     return out or "<root>"
 
 

@@ -281,6 +281,13 @@ class MaterialSpec(Strict):
     rgba: Rgba
 
 
+class MaintainerSpec(Strict):
+    """The package's maintainer (package.xml `<maintainer email>`), as rosdep and bloom want."""
+
+    name: Annotated[str, Field(min_length=1, pattern=r"^[^\n]+$")]
+    email: Annotated[str, Field(pattern=r"^[^@\s]+@[^@\s]+\.[^@\s]+$")]
+
+
 class PublishedSpec(Strict):
     """Published ratings and reference figures; the checks compare the outputs to these."""
 
@@ -340,3 +347,7 @@ class RobotSpec(Strict):
     #: URDF `<gazebo>`, `<transmission>` and `<ros2_control>` elements, each as its XML text,
     #: written into the kit's URDF verbatim after the joints (spec/urdf_blocks.py)
     urdf_blocks: tuple[str, ...] = ()
+    #: package.xml `<maintainer>` and `<license>` (an SPDX expression, e.g. "Apache-2.0");
+    #: without them the ROS 2 package gets emit/ros2.py's defaults and the build a warning
+    maintainer: MaintainerSpec | None = None
+    license: Annotated[str, Field(min_length=1, pattern=r"^[^\n]+$")] | None = None

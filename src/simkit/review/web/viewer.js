@@ -10,7 +10,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { STLLoader } from 'three/addons/loaders/STLLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
-const COLLISION_PIECE = /^meshes\/collision\/(.+)_(\d+)\.stl$/;
+const COLLISION_PIECE = /^meshes\/collision\/(.+)_(\d+)\.(stl|obj)$/;
 const PALETTE = [0xf25a1a, 0x1a8cf2, 0x33bf4d, 0xd933b3, 0xf2bf1a];
 const api = { ready: false, error: null, joints: [] };
 window.simkitViewer = api;
@@ -33,7 +33,7 @@ function setupScene(container) {
   renderer.setPixelRatio(window.devicePixelRatio);
   container.appendChild(renderer.domElement);
   const scene = new THREE.Scene();
-  scene.background = new THREE.Color(0xeef1f5);
+  scene.background = new THREE.Color(0x2a3240);  // dark: white robots stand out
   scene.add(new THREE.HemisphereLight(0xffffff, 0x8d8f94, 1.6));
   const key = new THREE.DirectionalLight(0xffffff, 1.6);
   key.position.set(2, 4, 2);
@@ -53,25 +53,103 @@ function setupScene(container) {
     render();
   };
   new ResizeObserver(resize).observe(container);
-  return { scene, camera, controls, render, resize };
+  const aspect = () => container.clientWidth / Math.max(container.clientHeight, 1);
+  return { scene, camera, controls, render, resize, aspect };
 }
 
-function frameCamera(view, object) {
-  const box = new THREE.Box3().setFromObject(object);
-  const centre = box.getCenter(new THREE.Vector3());
+// The visible meshes' vertices in world coordinates (three's frame), after `object`'s
+// current joint values; collision pieces and frame axes count only when shown.
+function visibleVertices(object, visit) {
+  object.updateMatrixWorld(true);
+  const point = new THREE.Vector3();
+  object.traverseVisible((node) => {
+    if (!node.isMesh) return;
+    const positions = node.geometry.attributes.position;
+    for (let i = 0; i < positions.count; i++) {
+      visit(point.fromBufferAttribute(positions, i).applyMatrix4(node.matrixWorld));
+    }
+  });
+}
+
+// The extent on the canvas, in normalised device coordinates, of the visible vertices of
+// `object` in every pose of `poses` (each a list of joint values for `setPose`).
+function poseBox(camera, object, poses, setPose) {
+  const lo = [Infinity, Infinity];
+  const hi = [-Infinity, -Infinity];
+  camera.updateMatrixWorld(true);
+  for (const values of poses) {
+    setPose(values);
+    visibleVertices(object, (p) => {
+      p.project(camera);
+      lo[0] = Math.min(lo[0], p.x); lo[1] = Math.min(lo[1], p.y);
+      hi[0] = Math.max(hi[0], p.x); hi[1] = Math.max(hi[1], p.y);
+    });
+  }
+  return { lo, hi };
+}
+
+// Frame the robot in every named pose (issue 25: with home alone, the flange left the canvas
+// in "stretched"): first a bounding sphere of the vertices of all poses, seen whole by the
+// narrower field of view; then a few steps that centre the poses' extent on the canvas and
+// move in until it fills FILL of the canvas in its longer direction.
+const FILL = 0.85;
+function frameCamera(view, object, poses, setPose) {
+  const { camera, controls } = view;
+  const box = new THREE.Box3();
+  for (const values of poses) {
+    setPose(values);
+    visibleVertices(object, (p) => box.expandByPoint(p));
+  }
+  if (box.isEmpty()) box.setFromObject(object);
+  const target = box.getCenter(new THREE.Vector3());
   const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.05);
-  const distance = (1.15 * radius) / Math.sin(THREE.MathUtils.degToRad(view.camera.fov / 2));
+  const halfV = THREE.MathUtils.degToRad(camera.fov / 2);
+  const halfH = Math.atan(Math.tan(halfV) * camera.aspect);
+  let distance = (1.05 * radius) / Math.sin(Math.min(halfV, halfH));
   // from +x, -y (kit frame) and above; the kit's (x, y, z) is three's (x, z, -y)
   const direction = new THREE.Vector3(1.2, 0.8, 1.6).normalize();
-  view.camera.position.copy(centre).addScaledVector(direction, distance);
-  view.camera.near = distance / 100;
-  view.camera.far = distance * 100;
-  view.camera.updateProjectionMatrix();
-  view.controls.target.copy(centre);
-  view.controls.update();
-  const grid = new THREE.GridHelper(radius * 4, 20, 0xa0a4aa, 0xc8cbd0);
+  const place = () => {
+    camera.position.copy(target).addScaledVector(direction, distance);
+    camera.near = distance / 100;
+    camera.far = distance * 100;
+    camera.lookAt(target);
+    camera.updateProjectionMatrix();
+  };
+  place();
+  for (let step = 0; step < 6; step++) {
+    const { lo, hi } = poseBox(camera, object, poses, setPose);
+    const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
+    const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+    target.addScaledVector(right, ((lo[0] + hi[0]) / 2) * Math.tan(halfH) * distance);
+    target.addScaledVector(up, ((lo[1] + hi[1]) / 2) * Math.tan(halfV) * distance);
+    const half = Math.max(hi[0] - lo[0], hi[1] - lo[1]) / 2;
+    distance *= Math.min(Math.max(half / FILL, 0.5), 2);
+    place();
+  }
+  for (let step = 0; step < 20; step++) { // never closer than the whole robot allows
+    const { lo, hi } = poseBox(camera, object, poses, setPose);
+    if (Math.min(...lo) >= -0.95 && Math.max(...hi) <= 0.95) break;
+    distance *= 1.1;
+    place();
+  }
+  controls.target.copy(target);
+  controls.update();
+  const grid = new THREE.GridHelper(radius * 4, 20, 0x5b6a7e, 0x3a4656);
   grid.position.y = Math.min(box.min.y, 0);
   view.scene.add(grid);
+}
+
+// The robot's extent on the canvas in normalised device coordinates ([-1, 1] is inside).
+function screenBox(view, object) {
+  const lo = [Infinity, Infinity];
+  const hi = [-Infinity, -Infinity];
+  view.camera.updateMatrixWorld(true);
+  visibleVertices(object, (p) => {
+    p.project(view.camera);
+    lo[0] = Math.min(lo[0], p.x); lo[1] = Math.min(lo[1], p.y);
+    hi[0] = Math.max(hi[0], p.x); hi[1] = Math.max(hi[1], p.y);
+  });
+  return { lo, hi };
 }
 
 function makeJoint(spec, model) {
@@ -168,6 +246,28 @@ function buildFrames(robot, model, size, render) {
   if (!names.length) box.textContent = 'none named in robot.json';
 }
 
+// A kit's OBJ collision piece (kitio/obj.py: `v x y z` and `f a b c` lines) as a geometry.
+async function loadObj(url) {
+  const text = await (await fetch(url)).text();
+  const vertices = [];
+  const corners = [];
+  for (const line of text.split('\n')) {
+    const parts = line.trim().split(/\s+/);
+    if (parts[0] === 'v') vertices.push(parts.slice(1, 4).map(Number));
+    if (parts[0] !== 'f') continue;
+    const ring = parts.slice(1).map((t) => {
+      const i = parseInt(t.split('/')[0], 10);
+      return i > 0 ? i - 1 : vertices.length + i;
+    });
+    for (let k = 1; k + 1 < ring.length; k++) corners.push(ring[0], ring[k], ring[k + 1]);
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(
+    corners.flatMap((i) => vertices[i]), 3));
+  geometry.computeVertexNormals();
+  return geometry;
+}
+
 async function buildCollision(files, model, render) {
   const box = document.getElementById('collision');
   const byLink = new Map();
@@ -189,7 +289,8 @@ async function buildCollision(files, model, render) {
     const group = new THREE.Group();
     group.name = `${link}_collision`;
     group.visible = false;
-    const geometries = await Promise.all(paths.map((p) => loader.loadAsync(`kit/${p}`)));
+    const geometries = await Promise.all(paths.map((p) => (p.endsWith('.obj')
+      ? loadObj(`kit/${p}`) : loader.loadAsync(`kit/${p}`))));
     geometries.forEach((geometry) => {
       const material = new THREE.MeshStandardMaterial({
         color: PALETTE[count++ % PALETTE.length], transparent: true, opacity: 0.55,
@@ -227,10 +328,18 @@ async function main() {
   const start = robot.joints.filter((j) => j.type !== 'fixed').map((_, i) => (robot.home ?? [])[i]);
   const sliders = buildSliders(joints, start, view.render);
   buildPoses(robot, joints, sliders);
-  frameCamera(view, model);
+  const setPose = (values) => joints.forEach((joint, i) => {
+    sliders[joint.name].input.value = values[i] ?? 0;
+    sliders[joint.name].set(Number(sliders[joint.name].input.value));
+  });
+  const poses = Object.values(robot.poses ?? {});
+  view.camera.aspect = view.aspect();
+  frameCamera(view, model, [...poses, start], setPose);
+  setPose(start);
   const size = new THREE.Box3().setFromObject(model).getSize(new THREE.Vector3()).length();
   buildFrames(robot, model, size / 10, view.render);
   const pieces = await buildCollision(files, model, view.render);
+  api.screenBox = () => screenBox(view, model);
   api.joints = joints.map(({ name, type, lower, upper }) => ({ name, type, lower, upper }));
   api.framePosition = (name) => {
     const node = model.getObjectByName(name);
