@@ -293,3 +293,17 @@ def test_written_meshes_do_not_depend_on_the_repair_s_face_order():
     _v, two = writer.canonical_faces(sphere.vertices, turned)
     assert np.array_equal(one, two)
     assert trimesh.Trimesh(sphere.vertices, two).is_watertight  # winding kept
+
+
+def test_wheels_are_no_legs(tmp_path):
+    """Two wheels below a frame on continuous joints: a bicycle does not stand, so the base
+    stays fixed; the same links on revolute joints are legs."""
+    body = box("frame", "0.6 0.1 0.1", mass=5.0)
+    for name, x in (("front", "0.3"), ("rear", "-0.3")):
+        body += box(name, "0.05 0.05 0.4", "0 0 -0.2", 1.0)
+        body += joint(name, "continuous", "frame", name, f"{x} 0 -0.05")
+    done = import_robot(write(tmp_path, body, "bike"), tmp_path / "bike")
+    assert any("fixed base:" in line for line in done.lines)
+    legs = body.replace('type="continuous"', 'type="revolute"')
+    done = import_robot(write(tmp_path, legs, "legs"), tmp_path / "legs")
+    assert any("floating base: 2 limbs" in line for line in done.lines)
