@@ -276,25 +276,6 @@ def test_home_off_the_zero_pose_is_reported(tmp_path):
     assert len(lines) == 1 and "joint[elbow]" in lines[0] and "home: 1," in lines[0]
 
 
-def test_written_meshes_do_not_depend_on_the_repair_s_face_order():
-    """The same closed mesh with its triangles shuffled and their corners rotated (as
-    trimesh's winding repair leaves them, run to run) gives the same triangles: a re-import
-    writes byte-identical STLs."""
-    import numpy as np
-    import trimesh
-
-    sphere = trimesh.creation.icosphere(2)
-    rng = np.random.default_rng(0)
-    shuffled = sphere.faces[rng.permutation(len(sphere.faces))]
-    turns = rng.integers(0, 3, len(shuffled))
-    turned = np.array([np.roll(f, k) for f, k in zip(shuffled, turns, strict=True)])
-    assert not np.array_equal(turned, sphere.faces)
-    _v, one = writer.canonical_faces(sphere.vertices, sphere.faces)
-    _v, two = writer.canonical_faces(sphere.vertices, turned)
-    assert np.array_equal(one, two)
-    assert trimesh.Trimesh(sphere.vertices, two).is_watertight  # winding kept
-
-
 def test_wheels_are_no_legs(tmp_path):
     """Two wheels below a frame on continuous joints: a bicycle does not stand, so the base
     stays fixed; the same links on revolute joints are legs."""

@@ -105,6 +105,11 @@ def _hull(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return vertices, np.array(hull.tri_verts, dtype=np.int64)
 
 
+#: m: the largest mesh a spec holds (spec/bounds.py `size`); a larger or non-finite scaled
+#: mesh (scale="1e300 1 1") is left out with a report line, not written with 0 triangles
+MAX_EXTENT = 100.0
+
+
 class MeshWriter:
     """Writes each distinct (file, scale) once, as meshes/NAME.stl under `out_dir`."""
 
@@ -142,8 +147,14 @@ class MeshWriter:
             turn = np.eye(4)
             turn[:3, :3] = Y_UP_TO_Z_UP
             mesh.apply_transform(turn)
-        mesh.apply_scale(np.asarray(scale, float))
+        with np.errstate(over="ignore", invalid="ignore"):
+            mesh.apply_scale(np.asarray(scale, float))
+            extent = float(np.ptp(np.asarray(mesh.vertices), axis=0).max())
+        if not np.isfinite(mesh.vertices).all() or extent > MAX_EXTENT:
+            raise ValueError(f"scale {scale} makes it {extent:g} m across (at most {MAX_EXTENT:g})")
         vertices, faces, repair = closed_solid(mesh)
+        if len(faces) == 0:
+            raise ValueError(f"scale {scale} leaves no triangles")
         vertices, faces = canonical_faces(vertices, faces)  # writer.py: same bytes every run
         solid = trimesh.Trimesh(vertices, faces, process=False)
         rel = self._name(path, scale)
