@@ -90,4 +90,3 @@ def _meshes_of(spec_path: Path) -> set[Path]:
                     if not rel.is_absolute() and ".." not in rel.parts:
                         out.add(rel)
     return out
-
