@@ -5,10 +5,11 @@ quadruped or a humanoid hang from the trunk or the pelvis, while an arm's base s
 bottom of the robot and its links rise from it. At the URDF's zero pose, each limb (a branch
 leaving the root's welded frame through a movable joint) reaches as low as the lowest origin
 or centre of mass of its links, in the root's frame. A limb is a leg when that is at least
-`LEG` of the robot's height span (and `MIN_DROP`) below the root; two legs make the base
-floating. Anything else keeps a fixed base (an arm bolted down, a wheeled base on a stand,
-a drone on a test rig). `--fixed-base` and `--floating-base` override the decision; the
-import reports it on one line either way.
+`LEG` of the robot's height span (and `MIN_DROP`) below the root and it has a joint with a
+range (a wheel, on continuous joints only, is no leg: a bicycle does not stand); two legs
+make the base floating. Anything else keeps a fixed base (an arm bolted down, a wheeled
+base on a stand, a drone on a test rig). `--fixed-base` and `--floating-base` override the
+decision; the import reports it on one line either way.
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ from simkit.importer.source import Source
 LEG = 0.25
 #: m: and at least this far below it (a flat robot's arms are no legs)
 MIN_DROP = 0.02
-MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating")
+MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating", "spherical")
+RANGED = ("revolute", "prismatic", "spherical")  # a limb with only continuous joints: wheels
 
 
 def _transform(source: Source, element) -> np.ndarray:
@@ -62,7 +64,8 @@ def _points(source: Source, links: dict, by_child: dict, root: str) -> dict[str,
 
 
 def _limbs(links: dict, by_child: dict, root: str) -> list[list[str]]:
-    """The links of each branch that leaves the root's welded frame through a movable joint."""
+    """The links of each branch that leaves the root's welded frame through a movable joint
+    and has a joint with a range (revolute, prismatic, spherical: not only wheels)."""
     kids: dict[str, list[str]] = {}
     for child, joint in by_child.items():
         kids.setdefault(joint.find("parent").get("link"), []).append(child)
@@ -80,7 +83,9 @@ def _limbs(links: dict, by_child: dict, root: str) -> list[list[str]]:
         node = stack.pop()
         for child in kids.get(node, []):
             if by_child[child].get("type") in MOVABLE:
-                limbs.append(below(child))
+                limb = below(child)
+                if any(by_child[n].get("type") in RANGED for n in limb):
+                    limbs.append(limb)
             else:
                 stack.append(child)
     return limbs

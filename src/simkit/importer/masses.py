@@ -32,7 +32,7 @@ DENSITY = 2700.0
 #: kg m^2 per N m of effort (kg per N for prismatic): a geared motor's reflected rotor inertia
 ARMATURE_PER_EFFORT = 1.0e-3
 #: the armature is at most this share of the axis inertia of what the joint moves
-ARMATURE_SHARE = 1.0
+ARMATURE_SHARE = 3.0
 #: rad/s: the servo frequency a bounded armature keeps (sqrt(100 / 1e-3): the frequency
 #: ARMATURE_PER_EFFORT gives simkit's servo; 0.63 rad per 2 ms step)
 SERVO_OMEGA = math.sqrt(1.0e5)

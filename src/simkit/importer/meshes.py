@@ -15,8 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.writer import canonical_faces
-
 #: COLLADA Y_UP to a Z-up frame: file (x, y, z) -> (x, -z, y)
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 
@@ -155,7 +153,6 @@ class MeshWriter:
         vertices, faces, repair = closed_solid(mesh)
         if len(faces) == 0:
             raise ValueError(f"scale {scale} leaves no triangles")
-        vertices, faces = canonical_faces(vertices, faces)  # writer.py: same bytes every run
         solid = trimesh.Trimesh(vertices, faces, process=False)
         rel = self._name(path, scale)
         target = self.out_dir / rel

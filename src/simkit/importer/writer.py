@@ -94,22 +94,3 @@ def _meshes_of(spec_path: Path) -> set[Path]:
                     if not rel.is_absolute() and ".." not in rel.parts:
                         out.add(rel)
     return out
-
-
-def canonical_faces(vertices, faces):
-    """The same closed mesh with its triangles in one order whatever order a repair left
-    them in (trimesh's winding fix visits faces in varying order): each triangle starts at
-    its lexicographically smallest corner (winding kept), triangles sorted by their corners'
-    coordinates. Byte-identical STL files for the same input mesh."""
-    import numpy as np
-
-    faces = np.asarray(faces)
-    corners = np.asarray(vertices, dtype=float)[faces]  # (n, 3, 3)
-    flat = corners.reshape(-1, 3)
-    rank = np.empty(len(flat), dtype=np.int64)
-    rank[np.lexsort(flat.T[::-1])] = np.arange(len(flat))
-    first = rank.reshape(-1, 3).argmin(axis=1)
-    turn = (np.arange(3)[None, :] + first[:, None]) % 3
-    rows = np.arange(len(faces))[:, None]
-    ordered = corners[rows, turn].reshape(len(faces), 9)
-    return vertices, faces[rows, turn][np.lexsort(ordered.T[::-1])]
