@@ -2,6 +2,7 @@
 
     python scripts/import_corpus.py CORPUS_DIR [--exclude GLOB ...] [--movable-only]
         [--only GLOB ...] [--title TITLE] [--timeout S] [--out DIR] [--md FILE] [--limit N]
+        [--ray]
 
 Each URDF (sorted by path, `--exclude` globs matched against the path relative to
 CORPUS_DIR): `simkit import URDF --out DIR` with no other flag, a cold build with an empty
@@ -10,7 +11,9 @@ import either refuses in one line naming the URDF's own file, or writes a spec t
 validates, builds and compiles in MuJoCo; never a traceback; the re-import gives
 byte-identical files and no stale ones. The table (one per `--title`, default the folder's
 name) goes into docs/import-corpus.md, replacing that corpus's earlier table, with the
-median import + cold build time. Runs one command at a time. No robot is named here.
+median import + cold build time. Runs one command at a time, or with `--ray` one Ray task
+per URDF ($RAY_ADDRESS, else a local Ray), rows in the same order: the same table. No robot
+is named here.
 """
 
 from __future__ import annotations
@@ -202,6 +205,7 @@ def main() -> None:
     parser.add_argument("--limit", type=int, default=0, help="run the first N only")
     parser.add_argument("--out", type=Path, default=Path("/tmp/simkit-corpus"))
     parser.add_argument("--md", type=Path, default=REPO / "docs" / "import-corpus.md")
+    parser.add_argument("--ray", action="store_true", help="one Ray task per URDF")
     args = parser.parse_args()
     root = args.corpus.resolve()
     if not root.is_dir():
@@ -214,14 +218,43 @@ def main() -> None:
         + " ".join(f"--exclude '{g}'" for g in args.exclude)
         + (" --movable-only" if args.movable_only else "")
     )
-    rows = []
-    for urdf in found:
-        rows.append(one(urdf, root, args.out, args.timeout))
-        r = rows[-1]
+
+    def done(rows: list[dict], r: dict) -> None:
         print(f"{r['robot']}: {r['import']} {r['build']} {r['invariant']} {r['reason']}",
               flush=True)  # fmt: skip
         save(args.md, title, command.strip(), table(rows, len(found)))
+
+    rows = (_on_ray if args.ray else _serial)(found, root, args, done)
     print(table(rows, len(found)))
+
+
+def _serial(found: list[Path], root: Path, args, done) -> list[dict]:
+    rows: list[dict] = []
+    for urdf in found:
+        rows.append(one(urdf, root, args.out, args.timeout))
+        done(rows, rows[-1])
+    return rows
+
+
+def _on_ray(found: list[Path], root: Path, args, done) -> list[dict]:
+    """One Ray task per URDF ($RAY_ADDRESS, else a local Ray; the corpus folder and `--out`
+    at the same paths on every worker); rows kept in the serial order, so the table is the
+    serial one."""
+    import os
+
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(address=os.environ.get("RAY_ADDRESS") or None, include_dashboard=False)
+    task = ray.remote(num_cpus=1, max_retries=2)(one)
+    index = {task.remote(urdf, root, args.out, args.timeout): i for i, urdf in enumerate(found)}
+    slots: list[dict | None] = [None] * len(found)
+    pending = list(index)
+    while pending:
+        ready, pending = ray.wait(pending, num_returns=1)
+        slots[index[ready[0]]] = row = ray.get(ready[0])
+        done([r for r in slots if r is not None], row)
+    return [r for r in slots if r is not None]
 
 
 if __name__ == "__main__":
