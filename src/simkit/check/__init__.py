@@ -36,6 +36,7 @@ _REGISTRY: dict[str, str] = {
     "self_collision": "self_collision:check_self_collision",
     "step": "step:check_step",
     "generated": "generated:check_generated",
+    "references": "references:check_references",
     "sdf": "sdf:check_sdf",
     "source": "source:check_source",
 }
