@@ -15,10 +15,15 @@ class Report:
     strict: bool = False
     lines: list[str] = field(default_factory=list)
     problems: list[SpecError] = field(default_factory=list)
+    _seen: set[str] = field(default_factory=set, repr=False)
 
     def _line(self, source: Source, element, kind: str, message: str) -> None:
+        """One line per fact: an attribute read twice (by two steps) is reported once."""
         where = f"{source.path.name}:{line_of(element) or '?'}"
-        self.lines.append(f"{where}: {describe(element)}: {kind}: {message}")
+        line = f"{where}: {describe(element)}: {kind}: {message}"
+        if line not in self._seen:
+            self._seen.add(line)
+            self.lines.append(line)
 
     def dropped(self, source: Source, element, message: str) -> None:
         """An element simkit does not keep."""
