@@ -12,6 +12,7 @@ Units: m, rad, kg, kg m^2, all in the link or joint frame the URDF defines.
 from __future__ import annotations
 
 import hashlib
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -52,15 +53,49 @@ class Allowed:
         return out
 
 
+#: attributes holding numbers that the comparison reads (origins, axes, limits, inertials)
+NUMERIC = {"xyz", "rpy", "value", "lower", "upper", "effort", "velocity", "damping", "friction"}
+NUMERIC |= {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}
+STRTOD = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _strtod(text: str) -> str:
+    """Each number as C's strtod reads it, as PyBullet and the importer do (`0.07, 0`,
+    `-1.57.`): its longest leading number, separated by spaces."""
+    found = (STRTOD.match(token) for token in re.split(r"[\s,]+", text.strip()) if token)
+    return " ".join(m.group(0) for m in found if m)
+
+
+def _comparable(path: Path) -> bytes:
+    """The URDF as the comparison reads it: without `<visual>` and `<collision>` (geometry is
+    not compared, and yourdfpy refuses shapes it does not know, such as PyBullet's
+    `<capsule>`), numbers read as strtod reads them."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    for parent in list(root.iter()):
+        for child in list(parent):
+            if child.tag in ("visual", "collision"):
+                parent.remove(child)
+            for key, text in child.attrib.items():
+                if key in NUMERIC:
+                    child.set(key, _strtod(text))
+    return ET.tostring(root, encoding="utf-8")
+
+
 def load_urdf(path: Path):
-    """The URDF's robot as yourdfpy reads it (no meshes loaded: kinematics and inertials)."""
+    """The URDF's robot as yourdfpy reads it (kinematics and inertials; see `_comparable`)."""
+    import io
     import logging
 
     import yourdfpy  # lazy: pulls in trimesh
 
     logging.getLogger("yourdfpy").setLevel(logging.ERROR)
     return yourdfpy.URDF.load(
-        str(path), load_meshes=False, build_scene_graph=False, build_collision_scene_graph=False
+        io.BytesIO(_comparable(path)),
+        load_meshes=False,
+        build_scene_graph=False,
+        build_collision_scene_graph=False,
     ).robot
 
 

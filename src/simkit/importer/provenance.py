@@ -104,7 +104,24 @@ def differences(
                 add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
             if kind == "joints" and element is not None and element.get("type") != item["type"]:
                 add(f"joints.{old}.type", said or f"a {element.get('type')} joint in the URDF")
+    _massless(source, add)
     return [out[k] for k in sorted(out)]
+
+
+def _massless(source: Source, add) -> None:
+    """A URDF link of zero mass with an `<inertial>` (a frame, a `world` root) gives its CoM
+    and inertia no meaning: a body without mass has none, and the kit writes none (after
+    the listed estimates, which take precedence)."""
+    for link in source.root.iter("link"):
+        mass = link.find("inertial/mass")
+        try:
+            massless = mass is not None and float(mass.get("value", "0")) == 0.0
+        except ValueError:
+            massless = False
+        if massless:
+            reason = "a massless link in the URDF: a body without mass has no CoM or inertia"
+            add(f"links.{link.get('name')}.com", reason)
+            add(f"links.{link.get('name')}.inertia", reason)
 
 
 def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
