@@ -45,3 +45,18 @@ def test_a_massless_links_com_and_inertia_are_listed(tmp_path):
     listed = {item["what"]: item["reason"] for item in spec["source_differences"]}
     assert "no CoM or inertia" in listed["links.world.inertia"]
     assert "links.world.com" in listed
+
+
+def test_a_transmission_naming_a_joint_is_no_reshaped_joint(tmp_path):
+    """`<transmission><joint name=...>` (no type) is a block's reference to a joint, not a
+    robot joint of a type the kit lacks."""
+    path = tmp_path / "r.urdf"
+    block = (
+        '<transmission name="t"><type>transmission_interface/SimpleTransmission</type>'
+        '<joint name="j"><hardwareInterface>EffortJointInterface</hardwareInterface></joint>'
+        "</transmission>\n</robot>"
+    )
+    path.write_text(URDF.replace("</robot>", block))
+    done = import_robot(path, tmp_path / "out")
+    spec = yaml.safe_load(done.spec_path.read_text())
+    assert not [d for d in spec["source_differences"] if d["what"].startswith("joints.j.")]

@@ -144,8 +144,8 @@ def _reshaped(spec: dict, source: Source, report: Said, back: dict[str, str], ad
     several kit joints through links the URDF lacks: the URDF joint's compared fields, and
     each kit link or joint the URDF lacks, are listed with the import's report line."""
     kinds = {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
-    for element in source.root.iter("joint"):
-        if element.get("type") in kinds:
+    for element in source.root.findall("joint"):  # the robot's joints, not a block's
+        if element.get("type") in kinds or not element.get("name"):
             continue
         said = _said(report, source, element) or f"a {element.get('type')} joint in the URDF"
         name = element.get("name")
