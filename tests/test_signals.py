@@ -372,6 +372,7 @@ def test_sigterm_ends_pool_workers_instead_of_waiting_for_their_jobs(tmp_path):
     deadline = time.monotonic() + 60
     while len(_tagged(tag)) < 2 and time.monotonic() < deadline:  # the worker has started
         time.sleep(0.02)
+    time.sleep(2.0)  # and is past its start-up (a spawned child on a loaded machine)
     start = time.monotonic()
     proc.send_signal(signal.SIGTERM)
     try:
