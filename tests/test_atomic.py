@@ -18,6 +18,7 @@ import pytest
 from simkit.check.generated import kit_files
 from simkit.kitio import atomic, layout, manifest
 from simkit.kitio.archive import read_zip, zip_bytes
+from tree_snapshot import snapshot
 
 ROBOT = "toy"
 SRC = str(Path(__file__).resolve().parents[1] / "src")
@@ -163,14 +164,7 @@ def test_kill_on_first_build_leaves_nothing_new_or_a_reported_gap(tmp_path, exch
         assert _visible(out) == (_files("new"), _files("new"))
 
 
-def _snapshot(out: Path) -> dict[str, tuple]:
-    """Every entry under `out` (itself included): kind, bytes, inode and mtime."""
-    seen = {}
-    for path in [out, *sorted(out.rglob("*"))]:
-        st = path.lstat()
-        data = path.read_bytes() if path.is_file() else None
-        seen[path.relative_to(out).as_posix()] = (st.st_mode, data, st.st_ino, st.st_mtime_ns)
-    return seen
+_snapshot = snapshot
 
 
 def test_a_build_that_changes_nothing_writes_nothing(tmp_path):

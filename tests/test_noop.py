@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from simkit.kitio import layout, manifest, noop
+from tree_snapshot import snapshot
 
 REPO = Path(__file__).resolve().parents[1]
 SRC = str(REPO / "src")
@@ -26,13 +27,7 @@ def _cli(*args: str, env: dict | None = None) -> subprocess.CompletedProcess:
     return subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
 
 
-def _snapshot(out: Path) -> dict[str, tuple]:
-    seen = {}
-    for path in [out, *sorted(out.rglob("*"))]:
-        st = path.lstat()
-        data = path.read_bytes() if path.is_file() else None
-        seen[path.relative_to(out).as_posix()] = (st.st_mode, data, st.st_ino, st.st_mtime_ns)
-    return seen
+_snapshot = snapshot
 
 
 @pytest.fixture(scope="module")

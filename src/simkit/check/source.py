@@ -139,37 +139,8 @@ def _digest(kit: Kit, path: Path) -> list[Finding]:
 def compare_robots(source, built, allowed: Allowed) -> list[Finding]:
     """Findings for yourdfpy robots `source` and `built` (the kit's URDF)."""
     out: list[Finding] = []
-    links = {link.name: link for link in built.links}
-    joints = {joint.name: joint for joint in built.joints}
-    seen_links, seen_joints = set(), set()
-    link_problems: list[str] = []
-    for link in source.links:
-        name = _kit_name(allowed.links, link.name, links)
-        if name not in links:
-            if f"links.{one_line(link.name)}" not in allowed.keys:
-                link_problems.append(f"link '{one_line(link.name)}' is missing from the kit")
-            continue
-        seen_links.add(name)
-        link_problems += _mass(link, links[name], allowed)
-    joint_problems: list[str] = []
-    for joint in source.joints:
-        name = _kit_name(allowed.joints, joint.name, joints)
-        if name not in joints:
-            if f"joints.{one_line(joint.name)}" not in allowed.keys:
-                joint_problems.append(f"joint '{one_line(joint.name)}' is missing from the kit")
-            continue
-        seen_joints.add(name)
-        joint_problems += _joint(joint, joints[name], allowed)
-    link_problems += [
-        f"link '{n}' is in the kit, not in the source"
-        for n in sorted(set(links) - seen_links)
-        if f"links.{n}" not in allowed.keys
-    ]
-    joint_problems += [
-        f"joint '{n}' is in the kit, not in the source"
-        for n in sorted(set(joints) - seen_joints)
-        if f"joints.{n}" not in allowed.keys
-    ]
+    link_problems = _paired("link", source.links, built.links, allowed.links, allowed, _mass)
+    joint_problems = _paired("joint", source.joints, built.joints, allowed.joints, allowed, _joint)
     out += _findings(
         "source.links",
         link_problems,
@@ -184,6 +155,27 @@ def compare_robots(source, built, allowed: Allowed) -> list[Finding]:
         "or are listed differences",
     )
     return out
+
+
+def _paired(kind: str, source: list, built: list, renames: dict, allowed: Allowed, compare):
+    """Problems of one kind of element: each source element paired with the kit's (under its
+    own or its listed name) and compared, and those only one side has, unless listed."""
+    kit = {item.name: item for item in built}
+    key, seen, problems = f"{kind}s", set(), []
+    for item in source:
+        name = _kit_name(renames, item.name, kit)
+        if name not in kit:
+            if f"{key}.{one_line(item.name)}" not in allowed.keys:
+                problems.append(f"{kind} '{one_line(item.name)}' is missing from the kit")
+            continue
+        seen.add(name)
+        problems += compare(item, kit[name], allowed)
+    problems += [
+        f"{kind} '{n}' is in the kit, not in the source"
+        for n in sorted(set(kit) - seen)
+        if f"{key}.{n}" not in allowed.keys
+    ]
+    return problems
 
 
 def _kit_name(renames: dict[str, str], name: str, kit: dict) -> str:
