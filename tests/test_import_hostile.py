@@ -132,15 +132,21 @@ def test_names_with_a_newline_cannot_inject_yaml(tmp_path):
     assert "link[arm\\ninjected: 1]: changed: renamed" in text
 
 
-def test_a_folder_left_by_a_killed_import_is_removed_by_the_next(tmp_path):
-    urdf = _write(tmp_path, _link("base"), _link("arm"), _joint("j", "base", "arm"))
-    out = tmp_path / "out"
-    # the command line turns SIGTERM into the normal clean-up (kitio/interrupt.py)
+def _import_until_staged(urdf, out):
+    """`simkit import` in a child process, returned once its staging folder exists (or it
+    ended). The command line turns SIGTERM into the normal clean-up (kitio/interrupt.py)."""
     cmd = [sys.executable, "-m", "simkit.cli", "import", str(urdf), "--out", str(out), "-q"]
     child = subprocess.Popen(cmd, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
     while not list(out.glob(".import-*")) and child.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)
+    return child
+
+
+def test_a_folder_left_by_a_killed_import_is_removed_by_the_next(tmp_path):
+    urdf = _write(tmp_path, _link("base"), _link("arm"), _joint("j", "base", "arm"))
+    out = tmp_path / "out"
+    child = _import_until_staged(urdf, out)
     child.send_signal(signal.SIGKILL)
     child.wait()
     left = list(out.glob(".import-*"))
@@ -156,12 +162,7 @@ def test_sigterm_removes_the_staging_folder(tmp_path):
         body += [_link(f"l{k}"), _joint(f"j{k}", f"l{k - 1}", f"l{k}", 0.05)]
     urdf = _write(tmp_path, *body)
     out = tmp_path / "out"
-    # the command line turns SIGTERM into the normal clean-up (kitio/interrupt.py)
-    cmd = [sys.executable, "-m", "simkit.cli", "import", str(urdf), "--out", str(out), "-q"]
-    child = subprocess.Popen(cmd, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 60
-    while not list(out.glob(".import-*")) and child.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.01)
+    child = _import_until_staged(urdf, out)
     if child.poll() is not None:
         pytest.skip("the import ended before SIGTERM")
     child.send_signal(signal.SIGTERM)
