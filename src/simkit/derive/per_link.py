@@ -20,7 +20,7 @@ import numpy as np
 
 from simkit.errors import SpecError
 from simkit.kitio.cache import Cache, decode_json, encode_json, make_key
-from simkit.model.robot import Link, Mesh, Robot, Shape
+from simkit.model.robot import Link, Mesh, Robot, Shape, canonical_triangles
 
 Progress = Callable[[str], None]
 
@@ -130,16 +130,10 @@ def _shape_hull(shape: Shape, base_dir: Path) -> Mesh:
 
 
 def canonical_faces(mesh: Mesh) -> Mesh:
-    """The same mesh with each triangle started at its lowest vertex index (winding kept) and
-    the triangles sorted. manifold3d's hull of the same points can list its triangles from a
-    different corner from one call to the next, which changed the cache key of every later
-    step (the first rebuild of an imported robot missed) and the collision STL bytes."""
-    faces = np.asarray(mesh.faces)
-    if not len(faces):
-        return mesh
-    start = np.argmin(faces, axis=1)
-    rolled = np.take_along_axis(faces, (start[:, None] + np.arange(3)) % 3, axis=1)
-    return Mesh.of(mesh.vertices, rolled[np.lexsort(rolled.T[::-1])])
+    """The same mesh with its triangles in one fixed order (`canonical_triangles`): a hull's
+    varying order changed the cache key of every later step (the first rebuild of an
+    imported robot missed) and the collision STL bytes."""
+    return Mesh.of(mesh.vertices, canonical_triangles(mesh.faces))
 
 
 # --- collision --------------------------------------------------------------------------

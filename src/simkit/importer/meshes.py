@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.model.robot import canonical_triangles
+
 #: COLLADA Y_UP to a Z-up frame: file (x, y, z) -> (x, -z, y)
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 
@@ -94,13 +96,14 @@ def closed_solid(mesh) -> tuple[np.ndarray, np.ndarray, str]:
 
 def _hull(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The convex hull as a closed manifold at STL's float32 precision. manifold3d's hull,
-    not qhull's: on a thin part (Iris's propeller blades, 1 cm thick) qhull leaves sliver
-    facets that are not a manifold once written as float32."""
+    not qhull's: on a thin part (a propeller blade 1 cm thick) qhull leaves sliver
+    facets that are not a manifold once written as float32. Its triangles come back in a
+    varying order, so they are put in one (`canonical_triangles`): a re-import is byte-identical."""
     import manifold3d as mf
 
     hull = mf.Manifold.hull_points(np.asarray(points, np.float32)).to_mesh()
     vertices = np.array(hull.vert_properties, dtype=np.float64)[:, :3]
-    return vertices, np.array(hull.tri_verts, dtype=np.int64)
+    return vertices, canonical_triangles(np.array(hull.tri_verts, dtype=np.int64))
 
 
 #: m: the largest mesh a spec holds (spec/bounds.py `size`); a larger or non-finite scaled

@@ -69,6 +69,19 @@ class Mesh:
         return Mesh(v, f)
 
 
+def canonical_triangles(faces: np.ndarray) -> np.ndarray:
+    """The same triangles in one fixed order: each turned (never flipped, so its normal keeps
+    its side) to start at its lowest vertex index, then sorted row by row. manifold3d's hull
+    runs on parallel threads and lists the same triangles in a varying order from one call
+    to the next; written as is, the bytes of a mesh file and every cache key after it vary."""
+    faces = np.asarray(faces)
+    if not len(faces):
+        return faces
+    start = np.argmin(faces, axis=1)
+    turned = np.take_along_axis(faces, (start[:, None] + np.arange(3)) % 3, axis=1)
+    return turned[np.lexsort(turned.T[::-1])]
+
+
 @dataclass(frozen=True)
 class InertiaDecision:
     """A recorded decision to keep a non-physical reported inertia (spec_sim.py): the reported
