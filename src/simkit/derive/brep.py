@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from simkit.derive.shellfix import over_shared, unpinched, without_needles
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Link, Mesh, Shape
 
@@ -206,18 +207,31 @@ def _host(vertices, parts, outer: list[int], volumes: list[float], cavity: int) 
 #: mm: vertices closer than this are one (Open CASCADE cannot make an edge shorter than its
 #: 1e-7 mm tolerance; CAD meshes carry such near-duplicates)
 WELD_MM = 1e-4
+#: mm: where that weld leaves no whole shell, the repairs of shellfix.py at each weld in turn
+REPAIR_WELDS_MM = (1e-4, 1e-3, 1e-2)
 
 
-def _welded(mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
-    """The mesh's used vertices (mm) with near-duplicates merged, and its triangles (0-based)
-    without the ones that merging collapsed."""
-    faces = np.asarray(mesh.faces, dtype=int)
-    used, local = np.unique(faces.ravel(), return_inverse=True)
-    points = np.asarray(mesh.vertices, dtype=float)[used] * MM
+def _welded(points: np.ndarray, triangles: np.ndarray, weld: float, repair: bool):
+    """`points` (mm) merged per cell of `weld` (mm), and the triangles (0-based) that keep
+    three corners. With `repair`, an edge left on more than two triangles (slivers, or a
+    solid touching itself along an edge) is split per fan and needles are flipped away
+    (shellfix.py): Open CASCADE refuses the one and drops the other's face."""
+    nodes, triangles = _merged(points, triangles, weld)
+    if not repair:
+        return nodes, triangles
+    if over_shared(triangles):
+        nodes, triangles = unpinched(nodes, triangles)
+    return nodes, without_needles(nodes, triangles, weld)
+
+
+def _merged(
+    points: np.ndarray, triangles: np.ndarray, weld: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """`points` merged per cell of `weld` (mm), and the triangles that keep three corners."""
     _, first, merged = np.unique(
-        np.round(points / WELD_MM), axis=0, return_index=True, return_inverse=True
+        np.round(points / weld), axis=0, return_index=True, return_inverse=True
     )
-    triangles = merged.ravel()[local].reshape(-1, 3)
+    triangles = merged.ravel()[triangles]
     keep = (
         (triangles[:, 0] != triangles[:, 1])
         & (triangles[:, 1] != triangles[:, 2])
@@ -234,6 +248,22 @@ def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
     or a vertex still gives the right shell) in C++, ten times faster than building the
     faces one by one from Python; the faces keep the triangles' outward winding.
     """
+
+    faces = np.asarray(mesh.faces, dtype=int)
+    used, local = np.unique(faces.ravel(), return_inverse=True)
+    points = np.asarray(mesh.vertices, dtype=float)[used] * MM
+    attempts = [(WELD_MM, False)] + [(weld, True) for weld in REPAIR_WELDS_MM]
+    for weld, repair in attempts:
+        nodes, triangles = _welded(points, local.reshape(-1, 3), weld, repair)
+        solid, whole = _closed_solid(nodes, triangles)
+        if whole:
+            break
+    return solid
+
+
+def _closed_solid(nodes: np.ndarray, triangles: np.ndarray) -> tuple[TopoDS_Shape, bool]:
+    """One faceted solid of the triangles (0-based) on `nodes` (mm), and True when it has a
+    face for every triangle and no edge on more than two: a whole, closed shell."""
     from OCP.BRep import BRep_Builder
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeShapeOnMesh
     from OCP.gp import gp_Pnt
@@ -242,38 +272,37 @@ def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
-    nodes, triangles = _welded(mesh)
-    triangles = triangles + 1  # Poly_Triangulation counts from 1
     triangulation = Poly_Triangulation(len(nodes), len(triangles), False)
     for i, (x, y, z) in enumerate(nodes.tolist(), 1):
         triangulation.SetNode(i, gp_Pnt(x, y, z))
-    for i, (a, b, c) in enumerate(triangles.tolist(), 1):
+    for i, (a, b, c) in enumerate((triangles + 1).tolist(), 1):  # counted from 1
         triangulation.SetTriangle(i, Poly_Triangle(a, b, c))
     maker = BRepBuilderAPI_MakeShapeOnMesh(triangulation)
     try:
         maker.Build()
     except Exception:  # StdFail_NotDone, e.g. on a zero-area sliver, which has no plane
-        return _faceted_solid_by_face(nodes, triangles - 1)
+        return _faceted_solid_by_face(nodes, triangles)
     if not maker.IsDone():
-        return _faceted_solid_by_face(nodes, triangles - 1)
+        return _faceted_solid_by_face(nodes, triangles)
     builder = BRep_Builder()
     shell = TopoDS_Shell()
     builder.MakeShell(shell)
-    explorer = TopExp_Explorer(maker.Shape(), TopAbs_FACE)
+    explorer, count = TopExp_Explorer(maker.Shape(), TopAbs_FACE), 0
     while explorer.More():
         builder.Add(shell, explorer.Current())
         explorer.Next()
+        count += 1
     shell.Closed(True)
     solid = TopoDS_Solid()
     builder.MakeSolid(solid)
     builder.Add(solid, shell)
-    return solid
+    return solid, count == len(triangles) and not over_shared(triangles)
 
 
-def _faceted_solid_by_face(nodes: np.ndarray, triangles: np.ndarray) -> TopoDS_Shape:
+def _faceted_solid_by_face(nodes: np.ndarray, triangles: np.ndarray) -> tuple[TopoDS_Shape, bool]:
     """`faceted_solid` built face by face (mm nodes, 0-based triangles), for a mesh that
     OCCT's mesh builder refuses: a zero-area sliver gets no face, its edges are shared by its
-    neighbours already. About ten times slower."""
+    neighbours already. About ten times slower. Taken as whole (True), as it always was."""
     from OCP.BRep import BRep_Builder
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace as MakeFace
@@ -303,7 +332,7 @@ def _faceted_solid_by_face(nodes: np.ndarray, triangles: np.ndarray) -> TopoDS_S
     solid = TopoDS_Solid()
     builder.MakeSolid(solid)
     builder.Add(solid, shell)
-    return solid
+    return solid, True
 
 
 def link_shape(link: Link) -> TopoDS_Shape | None:
