@@ -152,6 +152,8 @@ BOUNDS = [
     ("title", "title: Planar 2R\n", f"title: {'x' * 5000}\n", "title", "at most 200"),
     ("title_lines", "title: Planar 2R\n", 'title: "a\\nb"\n', "title", "control"),
     ("seed", "seed: 1\n", "seed: 100000000000000000000\n", "seed", "at most"),
+    # validated, then numpy refused it in the build: "expected non-negative integer" (fuzz)
+    ("seed_negative", "seed: 1\n", "seed: -1\n", "seed", "greater than or equal to 0"),
 ]
 
 

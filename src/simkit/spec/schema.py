@@ -351,7 +351,8 @@ class RobotSpec(Strict):
     poses_deg: dict[str, tuple[float, ...]] = Field(default_factory=dict)
     poses: dict[str, tuple[float, ...]] = Field(default_factory=dict)
     published: PublishedSpec = PublishedSpec()
-    seed: int = 0
+    #: seeds every random draw of the build (numpy wants it non-negative)
+    seed: Annotated[int, Field(ge=0)] = 0
     mjcf: MjcfSpec | None = None
     planning_groups: tuple[PlanningGroupSpec, ...] = ()
     #: Folder name under the download site's /assets/sim/ (the page's `<model>`, e.g. "1000");
