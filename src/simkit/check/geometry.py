@@ -12,6 +12,7 @@ from simkit.check.mujoco import random_configs
 from simkit.check.readers.glb import read_glb
 from simkit.kitio.obj import read_mesh
 from simkit.kitio.stl import from_stl
+from simkit.model.hull import facet_depth, facet_planes
 from simkit.model.kinematics import axis_angle, quat_matrix, transform
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
@@ -47,12 +48,42 @@ def _hull_outside(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     return (points @ planes[:, :3].T + planes[:, 3]).max(axis=1)
 
 
+def _cover_gap(points: np.ndarray, pieces: list[np.ndarray]) -> float:
+    """The largest distance (m) of a point outside every piece's convex hull; 0 when each
+    lies in one. A point that qhull's tetrahedra of some piece hold is inside it; only the
+    others are measured against every facet plane of every piece (a 13,000-facet given hull
+    against its 6,500 visual vertices took 3 s measured in full)."""
+    from scipy.spatial import Delaunay, QhullError
+
+    left = np.asarray(points, dtype=float)
+    for vertices in pieces:
+        try:
+            held = Delaunay(np.asarray(vertices, dtype=float)).find_simplex(left) >= 0
+        except (QhullError, ValueError):  # flat or too few points: holds nothing
+            continue
+        left = left[~held]
+        if not len(left):
+            return 0.0
+    depth = np.min([_hull_outside(left, vertices) for vertices in pieces], axis=0)
+    return max(0.0, float(depth.max()))
+
+
+#: m: a dent shallower than this is measured no closer (model/hull.py `facet_depth`)
+DENT_FLOOR = 1e-12
+
+
 def _dent(vertices: np.ndarray, faces: np.ndarray) -> float:
     """How deep the mesh's surface lies inside its own convex hull (m): 0 for a convex mesh.
     A face lies on the hull's boundary exactly when its centre does, so the vertices and face
     centres are tested."""
+    from scipy.spatial import QhullError
+
     samples = np.vstack([vertices, vertices[faces].mean(axis=1)])
-    return max(0.0, -float(_hull_outside(samples, vertices).min()))
+    try:
+        hull = facet_planes(vertices)
+    except (QhullError, ValueError):  # flat or too few points: no solid to be inside of
+        return 0.0
+    return max(0.0, -float(facet_depth(samples, hull, -DENT_FLOOR).min()))
 
 
 def check_collision(kit: Kit) -> list[Finding]:
@@ -75,8 +106,7 @@ def check_collision(kit: Kit) -> list[Finding]:
             worst_convex = max(worst_convex, _dent(piece.vertices, piece.faces))
         if link["mesh"]["visual"]:
             visual = from_stl(kit.path(link["mesh"]["visual"]).read_bytes()).vertices
-            depth = np.min([_hull_outside(visual, p.vertices) for p in pieces], axis=0)
-            worst_cover = max(worst_cover, float(depth.max()))
+            worst_cover = max(worst_cover, _cover_gap(visual, [p.vertices for p in pieces]))
     return [
         require(
             "collision.pieces",

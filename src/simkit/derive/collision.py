@@ -26,6 +26,7 @@ from dataclasses import asdict
 import numpy as np
 
 from simkit.errors import SpecError
+from simkit.model.hull import facet_depth, facet_planes
 from simkit.model.robot import Link, Mesh, Shape
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
@@ -141,13 +142,11 @@ def convex_mesh(solid) -> Mesh:
     fraction of a millimetre (TIAGo's arm_1_link: 0.4 mm); such a mesh is replaced by qhull's
     triangulated hull of the same vertices, faces turned outward. A convex mesh is kept as
     it is (the same bytes as before)."""
-    from scipy.spatial import ConvexHull
-
     mesh = _mesh(solid)
-    hull = ConvexHull(mesh.vertices)
+    hull = facet_planes(mesh.vertices)
     planes = hull.equations
     samples = np.vstack([mesh.vertices, mesh.vertices[mesh.faces].mean(axis=1)])
-    if -(samples @ planes[:, :3].T + planes[:, 3]).max(axis=1).min() <= CONVEX_EPS:
+    if -facet_depth(samples, hull, -CONVEX_EPS).min() <= CONVEX_EPS:
         return mesh
     keep = np.sort(hull.vertices)
     index = np.full(len(mesh.vertices), -1, dtype=np.int64)
