@@ -13,7 +13,7 @@ collision pieces, and visual and collision triangles.
     python scripts/bench.py                      # every robots/rosie_*.yaml
     python scripts/bench.py rosie_1000 tests/specs/collision_mix.yaml --warm 5 --json out.json
     python scripts/bench.py rosie_1000 --compare-step 3   # what the STEP assembly adds
-    python scripts/bench.py rosie_1000 /tmp/talos/talos.yaml --warm 1 --noop 5
+    python scripts/bench.py rosie_1000 /tmp/imported/humanoid.yaml --warm 1 --noop 5
 """
 
 from __future__ import annotations

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import site
-import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -21,6 +19,7 @@ import numpy as np
 import pytest
 import trimesh
 
+import corpus_pick
 from drake_load import load_kit
 from simkit.importer import import_robot
 from simkit.kitio.cache import Cache
@@ -202,23 +201,18 @@ def test_spec_collision_mesh_loads_in_drake(tmp_path):
     assert methods["arm"]["coverage"] == pytest.approx(1.0)
 
 
-def _corpus() -> Path | None:
-    """example-robot-data's robots folder (the test extra installs it), or None."""
-    for base in [*site.getsitepackages(), *sys.path]:
-        path = Path(base) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-        if path.is_dir():
-            return path
-    return None
+def _hull_arm(robot) -> bool:
+    """Collision meshes, and movable joints that are all continuous."""
+    types = corpus_pick.movable(robot)
+    return bool(corpus_pick.meshes(robot, "collision")) and set(types) == {"continuous"}
 
 
 @pytest.mark.slow
 @needs_drake
 def test_example_robot_imported_with_hull_loads_in_drake(tmp_path):
-    """A small example-robot-data arm whose URDF has collision meshes, imported with --hull."""
-    corpus = _corpus()
-    if corpus is None:
-        pytest.skip("example-robot-data is not installed (test extra)")
-    source = corpus / "double_pendulum_description" / "urdf" / "double_pendulum_continuous.urdf"
+    """A small example-robot-data arm on continuous joints whose URDF has collision meshes
+    (the smallest such URDF, corpus_pick.py), imported with --hull."""
+    source = corpus_pick.pick(_hull_arm)
     done = import_robot(source, tmp_path / "spec", name="pendulum", hull_collision=True)
     built = build(str(done.spec_path), tmp_path / "kits", step=False)
     doc = json.loads((built.kit_dir / "robot.json").read_text())

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import math
 import shutil
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 import yaml
 from click.testing import CliRunner
 
+import corpus_pick
 from simkit.cli import main
 from simkit.errors import SpecError
 from simkit.importer import import_robot
@@ -17,17 +19,6 @@ from simkit.spec.validate import load_spec
 
 URDF = Path(__file__).resolve().parent / "specs" / "urdf"
 ARM = URDF / "pkg_demo" / "urdf" / "arm.urdf"
-
-
-def _corpus() -> Path | None:
-    """example-robot-data's robots folder (the test extra installs it), or None."""
-    import site
-
-    for base in site.getsitepackages():
-        path = Path(base) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-        if path.is_dir():
-            return path
-    return None
 
 
 def test_arm_keeps_the_urdf_numbers(tmp_path):
@@ -160,23 +151,45 @@ def test_cli_writes_spec(tmp_path):
     assert yaml.safe_load((tmp_path / "demo.yaml").read_text())["name"] == "demo"
 
 
+def _legged(robot) -> bool:
+    """package:// mesh URIs and eight or more movable joints, all revolute."""
+    uris = corpus_pick.meshes(robot, "visual") + corpus_pick.meshes(robot, "collision")
+    types = corpus_pick.movable(robot)
+    packaged = bool(uris) and all(u.startswith("package://") for u in uris)
+    return packaged and len(types) >= 8 and set(types) == {"revolute"}
+
+
+def _drawn(link) -> bool:
+    return link.find("visual") is not None or link.find("collision") is not None
+
+
+def _collada_arm(robot) -> bool:
+    """Movable joints, COLLADA visuals only, and a link with collision geometry but no visual."""
+    uris = corpus_pick.meshes(robot, "visual")
+    bare = [k for k in robot.iter("link") if _drawn(k) and k.find("visual") is None]
+    dae = bool(uris) and all(u.lower().endswith(".dae") for u in uris)
+    return dae and bool(bare) and bool(corpus_pick.movable(robot))
+
+
 def test_corpus_floating_base_and_dae(tmp_path):
-    """Solo 12 (package:// URIs, a floating base) and UR5 (DAE visuals, a mesh-less ee_link)."""
-    corpus = _corpus()
-    if corpus is None:
-        pytest.skip("example-robot-data is not installed (test extra)")
-    solo = import_robot(
-        corpus / "solo_description/robots/solo12.urdf", tmp_path / "solo", floating=True
-    )
-    spec, _doc = load_spec(solo.spec_path)
+    """A corpus robot with package:// URIs imported on a floating base, and one with DAE
+    visuals and a link without any (picked by those properties, corpus_pick.py)."""
+    source = corpus_pick.pick(_legged)
+    legged = import_robot(source, tmp_path / "legged", floating=True)
+    spec, _doc = load_spec(legged.spec_path)
     assert spec.floating_base and spec.joints[0].type == "floating"
-    assert sum(j.type == "revolute" for j in spec.joints) == 12
-    ur5 = import_robot(corpus / "ur_description/urdf/ur5_robot.urdf", tmp_path / "ur5")
-    spec, _doc = load_spec(ur5.spec_path)
-    assert len(spec.links) == 8 and any(
-        p.file.endswith(".stl") for link in spec.links for p in link.solid if p.shape == "mesh"
-    )
-    assert (tmp_path / "ur5" / "meshes" / "base.stl").is_file()
+    urdf = ET.parse(source).getroot()
+    assert sum(j.type == "revolute" for j in spec.joints) == len(corpus_pick.movable(urdf))
+    source = corpus_pick.pick(_collada_arm)
+    arm = import_robot(source, tmp_path / "arm")
+    spec, _doc = load_spec(arm.spec_path)
+    urdf = ET.parse(source).getroot()
+    drawn = {k.get("name") for k in urdf.iter("link") if _drawn(k)}
+    assert drawn <= {link.name for link in spec.links}  # the link without a visual too
+    files = {p.file for link in spec.links for p in link.solid if p.shape == "mesh"}
+    assert files and all(f.endswith(".stl") for f in files)
+    for uri in corpus_pick.meshes(urdf, "visual"):
+        assert (tmp_path / "arm" / "meshes" / f"{Path(uri).stem}.stl").is_file()
 
 
 def test_gazebo_transmission_and_ros2_control_blocks_are_kept_verbatim(tmp_path):

@@ -1,7 +1,7 @@
 """The importer's home for fixed bases (issue 15): a pose the kit's servos can hold against
-gravity (gravity.py: Baxter's and PR2's shoulders cannot hold their arms out level), and
+gravity (gravity.py: some arms' shoulders cannot hold them out level), and
 free of contact between the visual pieces the kit's collision pieces are grown to cover
-(home.py's second search: Alex's Sake fingers)."""
+(home.py's second search: a humanoid hand's fingers)."""
 
 from __future__ import annotations
 
@@ -76,7 +76,7 @@ def test_home_stays_where_the_joint_holds_its_arm(tmp_path):
 
 def test_home_clears_visual_pieces_the_collision_leaves_apart(tmp_path):
     # an arm turning about z whose collision box stops at 0.1 m but whose visual box reaches
-    # into a post fixed at 0.3 m (Alex's Sake fingers: collision meshes placed apart from
+    # into a post fixed at 0.3 m (a humanoid hand's fingers: collision meshes placed apart from
     # their visual ones); the kit grows its pieces to cover the visual, so they would touch
     body = "\n".join(
         [
@@ -94,7 +94,7 @@ def test_home_clears_visual_pieces_the_collision_leaves_apart(tmp_path):
 
 
 def test_search_lets_a_pair_overlapping_at_the_start_go_a_little_deeper():
-    # Baxter's elbow: the hulls of two visual pieces overlap by 48 mm at the start and by
+    # an arm's elbow: the hulls of two visual pieces overlap by 48 mm at the start and by
     # 0.1 mm more as the elbow folds; the kit's pieces, which follow the mesh, stay apart
     search = object.__new__(gravity.Search)
     search.near = {(0, 1): -0.048, (2, 3): 0.01}
@@ -131,7 +131,7 @@ def _gripper(multiplier: float, lower: float, upper: float) -> str:
 
 
 def test_mimic_follower_gets_the_range_its_mimic_maps_the_leader_to(tmp_path):
-    # PR2's l_gripper_r_parallel_root_joint: multiplier -1 on a 0..0.548 leader, limits
+    # a parallel gripper's finger follower: multiplier -1 on a 0..0.548 leader, limits
     # 0..0.548, so any opening puts it out of its range
     robot, _home, lines = _import(tmp_path, _gripper(-1.0, 0.0, 0.5))
     joint = robot.joint("follow")

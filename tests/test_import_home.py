@@ -1,6 +1,6 @@
 """Fixed-base corpus repairs (issue 15): the "always in contact" rule the derive stage, the
 check and the importer's home search share (MoveIt's min_collision_fraction and a 1 um touch),
-and one USD articulation for a massless root frame holding several links (TIAGo)."""
+and one USD articulation for a massless root frame holding several links (a mobile manipulator)."""
 
 from __future__ import annotations
 
@@ -43,9 +43,9 @@ def _robot(tmp_path: Path, body: str):
     return resolve(spec, text.encode(), done.spec_path.name), done
 
 
-# A base with a wall fixed to it; a block sliding along the wall face on face (Baxter's finger
+# A base with a wall fixed to it; a block sliding along the wall face on face (a gripper's finger
 # blocks); an arm turning about z into a wide post fixed to the base, out of it only over the
-# last 2 % of its range (TIAGo's fingertip in the hand's safety box: 1.419 rad and up); a
+# last 2 % of its range (a fingertip in its hand's safety box: 1.419 rad and up); a
 # small link that never touches anything.
 ALWAYS = "\n".join(
     [

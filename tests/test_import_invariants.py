@@ -123,7 +123,7 @@ def test_an_inertia_on_the_limit_is_raised_off_it_and_mujoco_compiles_it(tmp_pat
 
 
 def _props() -> list[str]:
-    """A quadrotor: a frame and four props on fixed joints."""
+    """A drone: a frame and four props on fixed joints."""
     disc = '<geometry><cylinder radius="0.1" length="0.01"/></geometry>'
     out = [_link("frame")]
     for k, (x, y) in enumerate([(0.2, 0), (-0.2, 0), (0, 0.2), (0, -0.2)]):
@@ -142,12 +142,12 @@ def _props() -> list[str]:
         # a cube hinged on a massless `world` root: the parser leaves the cube out of the
         # articulation's bodies though its joint is articulated
         (['<link name="world"/>', _link("cube"), _joint("world", "cube", "hinge")], False),
-        # one body fixed to the world (a quadrotor's frame with the default fixed base)
+        # one body fixed to the world (a drone's frame with the default fixed base)
         ([_link("frame")], False),
-        # a floating quadrotor with fixed-only props: rigid, nothing to articulate
+        # a floating drone with fixed-only props: rigid, nothing to articulate
         (_props(), True),
     ],
-    ids=["hinged_cube", "fixed_quadrotor_frame", "floating_quadrotor_props"],
+    ids=["hinged_cube", "fixed_drone_frame", "floating_drone_props"],
 )
 def test_usd_articulation_passes_legitimate_small_imports(tmp_path, body, floating):
     from simkit.pipeline import build

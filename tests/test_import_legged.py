@@ -73,7 +73,7 @@ def test_floating_home_leaves_self_contact_feet_kept(tmp_path):
 
 def test_always_touching_pairs_are_found(tmp_path):
     """Two links whose boxes overlap at every configuration (a thigh inside its hip yaw's
-    box, as Talos's collision hulls do), and a pair that separates."""
+    box, as a humanoid's collision hulls do), and a pair that separates."""
     from simkit.derive.collision_pairs import always_pairs, configurations, welded_pairs
     from simkit.model.resolve import resolve
 
@@ -160,14 +160,14 @@ def test_corpus_script_takes_any_folder_with_default_flags(tmp_path):
     moving += '<parent link="a"/><child link="b"/></joint></robot>'
     (tmp_path / "arm").mkdir()
     (tmp_path / "arm" / "arm.urdf").write_text(moving)
-    (tmp_path / "random_urdfs").mkdir()
-    (tmp_path / "random_urdfs" / "x.urdf").write_text(moving)
+    (tmp_path / "generated_urdfs").mkdir()
+    (tmp_path / "generated_urdfs" / "x.urdf").write_text(moving)
     (tmp_path / "block.urdf").write_text('<robot name="b"><link name="b"/></robot>')
-    found = corpus.urdfs(tmp_path, ["random_urdfs/*"], movable_only=True)
+    found = corpus.urdfs(tmp_path, ["generated_urdfs/*"], movable_only=True)
     assert [p.relative_to(tmp_path).as_posix() for p in found] == ["arm/arm.urdf"]
     assert len(corpus.urdfs(tmp_path, [], movable_only=False)) == 3
-    assert corpus._name(Path("talos_data/robots/talos-full.v2.urdf")) == (
-        "talos_data_robots_talos_full"
+    assert corpus._name(Path("humanoid_data/robots/humanoid-full.v2.urdf")) == (
+        "humanoid_data_robots_humanoid_full"
     )
     long = corpus._name(Path("a_very_long_folder_name/another_long_folder/robot_name.urdf"))
     assert len(long) <= 48 and long != corpus._name(Path("a_very_long_folder_name/x.urdf"))
@@ -180,7 +180,7 @@ def test_corpus_script_takes_any_folder_with_default_flags(tmp_path):
 
 def _walker() -> str:
     """Two legs whose thighs reach up into the body past a hip-yaw link: body and thigh
-    touch in every configuration (as Talos's hip hulls do), and the arm starts in a leg."""
+    touch in every configuration (as a humanoid's hip hulls do), and the arm starts in a leg."""
     legs = ""
     for side, y in (("left", 0.1), ("right", -0.1)):
         legs += (

@@ -67,9 +67,9 @@ def test_a_flattened_package_uri_is_found_by_its_tail(tmp_path):
 
 
 def test_a_package_prefix_that_names_folders_above_is_dropped(tmp_path):
-    uri = "package://drake/examples/atlas/urdf/meshes/part.stl"
-    urdf = _write(tmp_path / "atlas" / "urdf" / "atlas.urdf", _robot(uri))
-    _write(tmp_path / "atlas" / "urdf" / "meshes" / "part.stl")
+    uri = "package://drake/examples/mybot/urdf/meshes/part.stl"
+    urdf = _write(tmp_path / "mybot" / "urdf" / "mybot.urdf", _robot(uri))
+    _write(tmp_path / "mybot" / "urdf" / "meshes" / "part.stl")
     assert "using meshes/part.stl" in _lines(urdf)[0]
 
 

@@ -1,6 +1,6 @@
 """`simkit import --floating-base` (issue 15), second round: a Y-up robot is turned upright,
 a URDF without any geometry gets estimated boxes, alike joints of all legs move together
-(HyQ), and the standing height is exact for tilted round shapes. Small handwritten URDFs."""
+(a quadruped), and the standing height is exact for tilted round shapes. Small handwritten URDFs."""
 
 from __future__ import annotations
 

@@ -277,13 +277,13 @@ def test_home_off_the_zero_pose_is_reported(tmp_path):
 
 
 def test_wheels_are_no_legs(tmp_path):
-    """Two wheels below a frame on continuous joints: a bicycle does not stand, so the base
+    """Two wheels below a frame on continuous joints: a two-wheeler does not stand, so the base
     stays fixed; the same links on revolute joints are legs."""
     body = box("frame", "0.6 0.1 0.1", mass=5.0)
     for name, x in (("front", "0.3"), ("rear", "-0.3")):
         body += box(name, "0.05 0.05 0.4", "0 0 -0.2", 1.0)
         body += joint(name, "continuous", "frame", name, f"{x} 0 -0.05")
-    done = import_robot(write(tmp_path, body, "bike"), tmp_path / "bike")
+    done = import_robot(write(tmp_path, body, "two_wheeler"), tmp_path / "two_wheeler")
     assert any("fixed base:" in line for line in done.lines)
     legs = body.replace('type="continuous"', 'type="revolute"')
     done = import_robot(write(tmp_path, legs, "legs"), tmp_path / "legs")

@@ -1,6 +1,6 @@
-"""COLLADA `<up_axis>Y_UP</up_axis>` meshes (issue 15, iCub): kept as stored, as ROS tools load
-them, unless the URDF's own child joints and inertial CoMs say the meshes were drawn Y-up;
-then turned Z-up and reported. Tiny URDFs and a DAE written by the test."""
+"""COLLADA `<up_axis>Y_UP</up_axis>` meshes (issue 15, found on a humanoid): kept as stored,
+as ROS tools load them, unless the URDF's own child joints and inertial CoMs say the meshes
+were drawn Y-up; then turned Z-up and reported. Tiny URDFs and a DAE written by the test."""
 
 from __future__ import annotations
 

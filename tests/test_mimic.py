@@ -1,5 +1,5 @@
 """A mimic joint's MJCF equality holds a loaded follower to its leader (emit/mjcf.py's
-MIMIC_* settings): MuJoCo's default softness let PR2's finger followers sag 0.7 deg."""
+MIMIC_* settings): MuJoCo's default softness let a parallel gripper's mimic fingers sag 0.7 deg."""
 
 from __future__ import annotations
 

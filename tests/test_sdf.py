@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+import corpus_pick
 from simkit.check.kit import Kit
 from simkit.check.sdf import check_sdf
 from simkit.emit import sdf
@@ -92,33 +93,32 @@ def test_libsdformat_refuses_a_broken_model(sdf_loader, tmp_path):
     assert done.returncode == 1 and "link_9" in done.stdout, done.stdout
 
 
-def _corpus() -> Path | None:
-    """example-robot-data's robots folder (the test extra installs it), or None."""
-    for base in map(Path, sys.path):
-        path = base / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
-        if path.is_dir():
-            return path
-    return None
+def _continuous(robot) -> bool:
+    """Movable joints, all continuous."""
+    types = corpus_pick.movable(robot)
+    return bool(types) and set(types) == {"continuous"}
 
 
-#: Two small example-robot-data robots: a fixed 2-DOF arm with continuous joints, and one
-#: with mesh visuals.
-IMPORTED = (
-    "double_pendulum_description/urdf/double_pendulum_continuous.urdf",
-    "asr_twodof_description/urdf/TwoDofs.urdf",
-)
+def _collada(robot) -> bool:
+    """Revolute joints and mesh visuals, COLLADA files only."""
+    uris = corpus_pick.meshes(robot, "visual")
+    dae = bool(uris) and all(u.lower().endswith(".dae") for u in uris)
+    return dae and "revolute" in corpus_pick.movable(robot)
+
+
+#: Two small example-robot-data robots (the smallest URDFs with these properties,
+#: corpus_pick.py): an arm on continuous joints, and one with mesh visuals.
+IMPORTED = {"continuous": _continuous, "collada": _collada}
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("source", IMPORTED)
-def test_libsdformat_loads_imported_robots(sdf_loader, source, tmp_path):
-    corpus = _corpus()
-    if corpus is None:
-        pytest.skip("example-robot-data is not installed (test extra)")
+@pytest.mark.parametrize("kind", IMPORTED)
+def test_libsdformat_loads_imported_robots(sdf_loader, kind, tmp_path):
+    source = corpus_pick.pick(IMPORTED[kind])
     name = "imported"
     simkit = [sys.executable, "-m", "simkit.cli"]
     imported = subprocess.run(
-        [*simkit, "import", str(corpus / source), "--name", name, "--out", str(tmp_path), "-q"],
+        [*simkit, "import", str(source), "--name", name, "--out", str(tmp_path), "-q"],
         capture_output=True,
         text=True,
     )

@@ -248,7 +248,7 @@ def test_passive_springs_are_drives(kit_factory, tmp_path):
 @pytest.mark.parametrize("angle", [3.8e-6, 1e-4, 0.01, 0.3, 3.14159])
 def test_orient_keeps_small_turns_as_usd_reads_them(angle):
     """USD reads an orient quaternion's angle from its real part (2 acos w): a link turned
-    3.8e-6 rad (iCub's r_elbow_1) must not come back unturned."""
+    3.8e-6 rad (a humanoid's elbow link in the corpus) must not come back unturned."""
     from pxr import Usd, UsdGeom
 
     from simkit.emit.usd import _place

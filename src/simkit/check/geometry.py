@@ -38,7 +38,8 @@ def _hull_outside(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     The planes are qhull's facet hyperplanes, not each triangle's own: a convex piece grown
     to cover a visual mesh has sliver faces (area ~1e-9 m^2) between near-coplanar vertices,
     whose cross-product normal can tilt by tens of degrees, so a plane through one of them
-    cuts the piece and reports a true convex piece as 0.1 m off (TIAGo's arm_1_link)."""
+    cuts the piece and reports a true convex piece as 0.1 m off (a 7-dof arm's upper link in
+    the corpus)."""
     from scipy.spatial import ConvexHull, QhullError
 
     try:

@@ -65,7 +65,7 @@ class Kit:
     def moved_links(self) -> set[str]:
         """Links a movable joint moves, directly or through the links above them (robot.json's
         joints and fixed joints). A floating base alone moves nothing relative to the rest: a
-        rigid robot, floating or fixed (a quadrotor and its props), has none."""
+        rigid robot, floating or fixed (a drone and its props), has none."""
         above = {j["child"]: (j["parent"], True) for j in self.joints}
         above.update({j["child"]: (j["parent"], False) for j in self.doc.get("fixed_joints", [])})
         out: set[str] = set()

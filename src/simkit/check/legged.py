@@ -99,7 +99,7 @@ def check_stand(kit: Kit) -> list[Finding]:
     model = _load(kit, file)
     if model.nu == 0 and kit.joints:
         return [require("legged.stand", False, f"{file} has no actuators to hold the pose")]
-    # no joints at all (a rigid quadrotor): nothing to hold, it must rest on its own
+    # no joints at all (a rigid drone): nothing to hold, it must rest on its own
     data = standing_state(kit, model)
     start = float(data.body(base).xpos[2])
     finite, heights = _run(model, data, HOLD_SECONDS, base)

@@ -19,7 +19,8 @@ def rounding_bound(kit: Kit, q) -> tuple[float, float]:
     from the spec's exact numbers, the check's FK from the written ones. Each written angle,
     length or joint value is off by at most `eps` times its size, an axis component likewise
     (a turn of at most sqrt(3) eps |q|). An origin angle near pi alone is off by 5e-10 rad,
-    so a chain of such origins (Kinova's URDF) exceeds a fixed 1e-9 with exact numbers."""
+    so a chain of such origins (one arm's URDF in the corpus) exceeds a fixed 1e-9 with exact
+    numbers."""
     eps = 0.5 * 10.0 ** (1 - SIGNIFICANT_DIGITS)
     values = dict(zip([j["name"] for j in kit.joints], q, strict=True))
     by_child = {j["child"]: j for j in kit.joints + kit.doc["fixed_joints"]}

@@ -365,7 +365,7 @@ def check_usd(kit: Kit) -> list[Finding]:
         moved = {str(p) for a in arts for p in a.articulatedJoints}
         held |= {b for j in joints if j.path in moved for b in (j.body0, j.body1)}
         # the parser may leave out a body whose only joint is the articulated one from the
-        # world (a hinged cube); a rigid robot (a quadrotor's frame and props, fixed or
+        # world (a hinged cube); a rigid robot (a drone's frame and props, fixed or
         # floating) has no joint to articulate
         need = {links[n] for n in kit.moved_links() if n in links}
         findings.append(

@@ -139,9 +139,9 @@ CONVEX_EPS = 1e-7
 def convex_mesh(solid) -> Mesh:
     """The mesh of a hull, exactly convex. manifold3d's hull of near-coplanar points (a piece
     grown by `cover` to take in visual vertices just outside it) can fold faces inward by a
-    fraction of a millimetre (TIAGo's arm_1_link: 0.4 mm); such a mesh is replaced by qhull's
-    triangulated hull of the same vertices, faces turned outward. A convex mesh is kept as
-    it is (the same bytes as before)."""
+    fraction of a millimetre (a 7-dof arm's upper link in the corpus: 0.4 mm); such a mesh is
+    replaced by qhull's triangulated hull of the same vertices, faces turned outward. A convex
+    mesh is kept as it is (the same bytes as before)."""
     mesh = _mesh(solid)
     hull = facet_planes(mesh.vertices)
     planes = hull.equations
@@ -249,9 +249,9 @@ def outside_depth(points: np.ndarray, hull: Mesh) -> np.ndarray:
 
     Exact, cell by cell: the points are binned in a grid of `CELLS` per side, and for a cell
     of radius r about c a face plane can give a point its maximum only if its distance at c
-    plus r reaches the largest distance at c minus r. A detailed hull (SO-101's base, 9,000
-    faces, against 100,000 surface samples) drops from every plane for every point (66 s on 2
-    cores) to the few planes facing each cell."""
+    plus r reaches the largest distance at c minus r. A detailed hull (a hobby arm's base,
+    9,000 faces, against 100,000 surface samples) drops from every plane for every point (66 s
+    on 2 cores) to the few planes facing each cell."""
     n, d = _halfspaces(hull)
     if not len(points):
         return np.zeros(0)
@@ -346,7 +346,8 @@ def max_distance_to_surface(points: np.ndarray, surface: Mesh, nearest: int = 4)
     give each point an upper bound; points are taken by that bound, largest first, each one
     compared exactly with every triangle whose lower bound is within its upper bound, and
     the walk stops at the first point whose upper bound cannot beat the maximum so far.
-    (It replaced a points x triangles bound matrix: SO-101's base took 77 s, on 2 cores.)"""
+    (It replaced a points x triangles bound matrix: that hobby arm's base took 77 s, on 2
+    cores.)"""
     from scipy.spatial import cKDTree
 
     if not len(points):

@@ -202,7 +202,7 @@ def welded_pairs(robot: Robot) -> set[tuple[str, str]]:
     """Link pairs whose contacts MuJoCo filters in the kit's MJCF by itself: bodies welded
     together by fixed joints, and a welded group with its parent group (the parent filter),
     except where the parent group is welded to the world: MuJoCo's parent filter skips the
-    world body (Baxter's head turns inside spheres fixed to its base, which do collide)."""
+    world body (a robot's head turning inside spheres fixed to its base, which do collide)."""
     parent = {j.child: j for j in robot.joints}
 
     def weld(link: str) -> str:
@@ -235,9 +235,9 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
     """Link pairs the kit's MJCF would let collide whose collision geometry is in contact (or
     within `TOUCH`, numerically touching) in at least `ALWAYS_FRACTION` of the configurations
     of `q` (MoveIt Setup Assistant's "Always", its min_collision_fraction): a URDF's
-    collision shapes that overlap wherever the joints are (Talos's hip-yaw and thigh hulls,
-    TIAGo's fingertip inside the hand's safety box but in one pose of a thousand, Baxter's
-    finger blocks sliding face on face) can never, or almost never, be separated, so their
+    collision shapes that overlap wherever the joints are (a humanoid's hip-yaw and thigh
+    hulls, a fingertip inside the hand's safety box but in one pose of a thousand, finger
+    blocks sliding face on face) can never, or almost never, be separated, so their
     contact is an artefact of the geometry, and the kit excludes it."""
     import mujoco
 

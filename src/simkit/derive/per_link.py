@@ -93,8 +93,8 @@ def derive_solids(robot: Robot, base_dir: Path, cache: Cache) -> Robot:
 
 
 def _given_hull(shape: Shape, base_dir: Path, cache: Cache) -> Mesh:
-    """`_shape_hull` through the cache, keyed by the mesh file's bytes and the placement: G1's
-    24 hulls (46,734 triangles) took 2.8 s of a 4.9 s warm rebuild."""
+    """`_shape_hull` through the cache, keyed by the mesh file's bytes and the placement: a
+    humanoid's 24 hulls (46,734 triangles) took 2.8 s of a 4.9 s warm rebuild."""
     from dataclasses import asdict
 
     if shape.kind != "mesh":

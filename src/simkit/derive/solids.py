@@ -17,7 +17,8 @@ from simkit.model.robot import Mesh, Shape
 
 CIRCULAR_SEGMENTS = 48
 #: A sphere curves both ways, so at 48 segments its mesh holds 1.01 % less than the true
-#: sphere (ANYmal's feet failed the STEP check's 1 % bound); 96 segments lose about 0.25 %.
+#: sphere (a quadruped's spherical feet failed the STEP check's 1 % bound); 96 segments lose
+#: about 0.25 %.
 SPHERE_SEGMENTS = 2 * CIRCULAR_SEGMENTS
 
 

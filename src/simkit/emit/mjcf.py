@@ -228,8 +228,8 @@ def emit(robot: Robot) -> dict[str, bytes]:
 
 
 #: A mimic joint's equality constraint: time constant in timesteps (MuJoCo's stable minimum is
-#: 2) and impedance. MuJoCo's default (0.02 s, 0.9..0.95) let PR2's and TIAGo Pro's finger
-#: followers sag 0.7 to 0.9 deg under their own weight, over the 0.5 deg a servo may; these
+#: 2) and impedance. MuJoCo's default (0.02 s, 0.9..0.95) let two parallel grippers' mimic
+#: finger followers sag 0.7 to 0.9 deg under their own weight, over the 0.5 deg a servo may; these
 #: keep a loaded follower within about 0.01 deg of its mimic (tests/test_mimic.py).
 MIMIC_TIMECONST_STEPS = 2.0
 MIMIC_SOLIMP = (0.95, 0.99, 0.001)

@@ -11,10 +11,11 @@ Layout of `usd/NAME.usda` (Z up, metres, kilograms):
   turned so the joint axis is the schema's X/Y/Z token; limits and drive gains follow the
   UsdPhysics units (degrees for angular joints). A joint from the root frame targets `/NAME`
   itself, so the robot stays fixed to wherever the asset is placed; a floating base has no
-  such joint. Where a massless root frame holds several links by fixed joints (TIAGo's
-  base_footprint: base_link, base_cover_link), only the first is fixed to `/NAME`; the others
-  are fixed to that first link at the same place, since UsdPhysics parsers start one
-  articulation per body fixed to the world (all of them are welded to the world either way).
+  such joint. Where a massless root frame holds several links by fixed joints (a mobile
+  manipulator's base_footprint: its base_link and a cover link), only the first is fixed to
+  `/NAME`; the others are fixed to that first link at the same place, since UsdPhysics
+  parsers start one articulation per body fixed to the world (all of them are welded to the
+  world either way).
 - `/NAME/Looks/MATERIAL`: one UsdPreviewSurface material per spec colour.
 
 The stage is built in memory and serialised with `Sdf.Layer.ExportToString`, so the text
@@ -59,9 +60,9 @@ ANGLE_TOL = 1e-8
 
 def _quat(rot: np.ndarray):
     """An orient quaternion as USD reads it back. USD takes the angle from the real part
-    (GfRotation: 2 acos w), so for a small turn 10 digits of w lose it: iCub's r_elbow_1 sits
-    3.8e-6 rad off its parent's frame, w = 1 - 1.8e-12 was written as 1, and USD placed the
-    link 6.6e-6 off its joint. There, and only there, w keeps 17 digits."""
+    (GfRotation: 2 acos w), so for a small turn 10 digits of w lose it: a humanoid's elbow
+    link sat 3.8e-6 rad off its parent's frame, w = 1 - 1.8e-12 was written as 1, and USD
+    placed the link 6.6e-6 off its joint. There, and only there, w keeps 17 digits."""
     from pxr import Gf
 
     exact = quat_wxyz(rot)

@@ -1,12 +1,13 @@
 """Alike joints of a legged robot's limbs, moved together by the stance search (stance.py).
 
-At HyQ's all-zero home each thigh sits 3.5 cm inside the trunk's collision hull. Every joint
-carries a foot, so moving one hip alone lifts that foot off the floor and the robot no
-longer rests on all of them; spreading all four hips by the same angle keeps the stance
-symmetric and the feet level. Alike joints: movable, not mimic, as many joints from the base,
-of the same type and with the same limits (HyQ's four `*_haa_joint`s). A limb on the -y side
-whose URDF frames do not mirror its joint (the same axis on both sides) turns the other way:
-both the same value and the value mirrored by side are tried.
+At one quadruped's all-zero home each thigh sat 3.5 cm inside the trunk's collision hull.
+Every joint carries a foot, so moving one hip alone lifts that foot off the floor and the
+robot no longer rests on all of them; spreading all four hips by the same angle keeps the
+stance symmetric and the feet level. Alike joints: movable, not mimic, as many joints from
+the base, of the same type and with the same limits (a quadruped's four hip abduction
+joints). A limb on the -y side whose URDF frames do not mirror its joint (the same axis on
+both sides) turns the other way: both the same value and the value mirrored by side are
+tried.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ bottom of the robot and its links rise from it. At the URDF's zero pose, each li
 leaving the root's welded frame through a movable joint) reaches as low as the lowest origin
 or centre of mass of its links, in the root's frame. A limb is a leg when that is at least
 `LEG` of the robot's height span (and `MIN_DROP`) below the root and it has a joint with a
-range (a wheel, on continuous joints only, is no leg: a bicycle does not stand); two legs
+range (a wheel, on continuous joints only, is no leg: a two-wheeler does not stand); two legs
 make the base floating. Anything else keeps a fixed base (an arm bolted down, a wheeled
 base on a stand, a drone on a test rig). `--fixed-base` and `--floating-base` override the
 decision; the import reports it on one line either way.

@@ -189,8 +189,8 @@ def always_touching(
 ) -> tuple:
     """Link pairs touching at the first guess and in at least `ALWAYS_FRACTION` of
     `ALWAYS_SAMPLES` seeded random configurations: URDF collision shapes that overlap wherever
-    (or almost wherever) the joints are (Panda collision primitives of links 1 and 3, TIAGo's
-    fingertips in the hand's safety box, Baxter's finger blocks face on face). The kit
+    (or almost wherever) the joints are (an arm's collision primitives of links 1 and 3, a
+    gripper's fingertips in the hand's safety box, finger blocks face on face). The kit
     excludes such pairs (derive collision_pairs "always", as MoveIt Setup Assistant does), so
     no pose can or need separate them; the search must not try, or it never moves the pair it
     could fix."""

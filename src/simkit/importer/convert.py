@@ -207,7 +207,7 @@ def convert(
         spec["mjcf"] = {"floor": {"name": "floor", "size": [0.0, 0.0, 0.05]}}
     tool = _deepest(spec_root, spec_joints, spec_frames)
     if tool and any(j["type"] not in ("fixed", "floating") for j in spec_joints):
-        # no tool on a robot without joints (a rigid quadrotor): nothing moves it
+        # no tool on a robot without joints (a rigid drone): nothing moves it
         spec["tool_frame"] = tool
     if colours:
         spec["materials"] = [{"name": n, "rgba": list(c)} for c, n in colours.items()]
@@ -254,7 +254,7 @@ def _estimated_mass(name: str, links: dict, by_child: dict) -> bool:
 
 def _visual_collision(source: Source, spec_links: list[dict], report: Report) -> None:
     """A floating robot whose URDF has no `<collision>` at all (a visual-only model such as
-    human.urdf) would fall through the floor: each link with a visual solid collides with
+    a biomechanics body) would fall through the floor: each link with a visual solid collides with
     that solid's convex hull instead (`collision: mesh`), marked estimated and reported."""
     done = 0
     for link in spec_links:
@@ -273,7 +273,7 @@ def _visual_collision(source: Source, spec_links: list[dict], report: Report) ->
 
 
 def _estimated_solids(source: Source, links: list[dict], joints: list[dict], report) -> None:
-    """A floating robot with no geometry at all (simple_humanoid_classical.urdf) gets an
+    """A floating robot with no geometry at all (a masses-only humanoid) gets an
     estimated box per link with a mass (solids.py), reported on one line."""
     from simkit.importer.solids import DENSITY, MAX_SIDE, add_solids
 

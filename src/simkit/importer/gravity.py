@@ -1,12 +1,12 @@
 """A home pose the kit's servos can hold against gravity (fixed bases; after home.py).
 
-A URDF's effort limits need not carry its arms everywhere: Baxter's shoulder `s1` needs
-56 N m against 50 N m with the arm stretched out level at 0, and PR2's shoulder lifts need
-52 N m against 30 N m (the real robots have counterbalance springs the URDFs leave out). At
-such a home the kit's position servo (kp = effort per 0.01 rad, force limited to the effort)
-sags far past the hold check's few tenths of a degree. A servo holds within about
-0.57 deg x (load / effort), so every actuated joint's static gravity load should stay within
-`LIMIT` of its effort (the kit page's 80 % rule).
+A URDF's effort limits need not carry its arms everywhere: a two-armed robot's shoulder
+needs 56 N m against 50 N m with the arm stretched out level at 0, and a mobile
+manipulator's shoulder lifts need 52 N m against 30 N m (the real robots have counterbalance
+springs the URDFs leave out). At such a home the kit's position servo (kp = effort per
+0.01 rad, force limited to the effort) sags far past the hold check's few tenths of a
+degree. A servo holds within about 0.57 deg x (load / effort), so every actuated joint's
+static gravity load should stay within `LIMIT` of its effort (the kit page's 80 % rule).
 
 The load is the spec's own: masses, CoMs and axes through simkit's Newton-Euler
 (model/rnea.py); a mimic follower without a servo of its own passes its load to its leader
@@ -16,7 +16,7 @@ that lowers the summed excess over `AIM` most (the arm hangs, or folds), nearest
 value on a tie, never at a limit, never bringing two links closer than the clearance (or
 than at home, where they are closer there) on home.py's model with the visual pieces the
 kit's collision covers (collide.covered_shapes). Where no such move is free, one other joint, above
-them or below, may move too (PR2's torso rises so a lowered arm clears the base). Effort
+them or below, may move too (a torso lift rises so a lowered arm clears the base). Effort
 numbers are never changed.
 """
 
@@ -37,7 +37,7 @@ SWEEPS = 3  # moves per joint at most
 ROOM = 4  # the best moves that may also move a joint above them, when none is free alone
 GAIN = 0.005  # the least cost a move must save (no turns for a wrist roll's 0.1 %)
 #: m: how much deeper a pair of pieces overlapping at the start may go (the hull of a visual
-#: piece is coarse where it overlaps its neighbour already: Baxter's elbow hulls go 0.1 mm
+#: piece is coarse where it overlaps its neighbour already: an elbow's hulls went 0.1 mm
 #: deeper as the elbow folds, while the kit's pieces, which follow the mesh, stay apart)
 SLACK = 0.001
 

@@ -1,14 +1,15 @@
 """A home pose free of self-contact for a fixed-base import (floating bases: stance.py).
 
 The importer's first guess at `home` is 0 for every joint (the middle of the range where 0
-is outside it). Many URDFs fold up at 0 (Panda's wrist, Z1's elbow, SO-100's jaw, PR2's arms
-inside the base), so the kit's servos would hold a pose its own links penetrate. This module
-measures self-contact with MuJoCo on the links' collision geometry (primitives, the convex
-hull of each given collision mesh, else the hull of each visual piece; links joined by a
-joint, or by links without geometry, never collide, as in the kit) and, where the guess is
-in contact, moves the joints between touching links one at a time (small turns first, then
-a grid of the range) to the value that leaves the least intrusion into `CLEARANCE`, until
-none is left or no move helps. The new pose is kept when no two links touch in it.
+is outside it). Many URDFs fold up at 0 (a 7-dof arm's wrist, a 6-dof arm's elbow, a hobby
+arm's jaw, a mobile manipulator's arms inside its base), so the kit's servos would hold a
+pose its own links penetrate. This module measures self-contact with MuJoCo on the links'
+collision geometry (primitives, the convex hull of each given collision mesh, else the hull
+of each visual piece; links joined by a joint, or by links without geometry, never collide,
+as in the kit) and, where the guess is in contact, moves the joints between touching links
+one at a time (small turns first, then a grid of the range) to the value that leaves the
+least intrusion into `CLEARANCE`, until none is left or no move helps. The new pose is kept
+when no two links touch in it.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ def free_home(robot, base_dir: Path, every: bool = False) -> tuple[list[float], 
     joints between two links in contact move, each to the grid value that leaves the least
     penetration, the one nearest the first guess on a tie. A second search, from the first
     one's pose, adds the links' visual pieces (covered_shapes), which the kit's collision pieces
-    are grown to cover (Alex's Sake fingers, whose collision meshes sit apart from their
+    are grown to cover (a humanoid hand's fingers, whose collision meshes sit apart from their
     visual ones, touch only there). `every`: pairs touching almost everywhere count too."""
 
     start, follow = posed(robot)

@@ -140,8 +140,8 @@ def _limits(
 
 
 def _unbounded(joint) -> bool:
-    """A revolute joint whose lower or upper limit lies beyond TURNS turns (Iris's rotors
-    give +-1e16): the URDF's way of saying it has none."""
+    """A revolute joint whose lower or upper limit lies beyond TURNS turns (a multirotor's
+    rotors give +-1e16): the URDF's way of saying it has none."""
     limit = joint.find("limit")
     if limit is None:
         return False
@@ -150,7 +150,7 @@ def _unbounded(joint) -> bool:
 
 
 def _reversed(joint) -> bool:
-    """A `<limit>` whose lower exceeds its upper (cube_no_rotation.urdf: 1 > -1): Bullet
+    """A `<limit>` whose lower exceeds its upper (a corpus cube: 1 > -1): Bullet
     reads it as no limit."""
     limit = joint.find("limit")
     if limit is None:
@@ -168,7 +168,7 @@ def _num(text: str) -> float | None:
 
 def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> None:
     """A mimic follower whose limits do not hold its leader's range mapped through the mimic
-    (PR2's `l_gripper_r_parallel_root_joint`: multiplier -1 on a 0..0.548 leader, limits
+    (a parallel gripper's finger follower: multiplier -1 on a 0..0.548 leader, limits
     0..0.548) gets that mapped range as its limits, marked estimated and reported: the
     URDF's limits contradict its own mimic (any opening puts the follower out of range), and
     the MJCF's equality would fight the follower's limit."""

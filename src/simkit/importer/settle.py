@@ -1,7 +1,7 @@
 """Where a floating robot that leans on a limb comes to rest: the free joint's pose at home.
 
 standing.py puts the base level with the lowest point of the geometry on the floor. A flying
-arm cannot rest that way: Hextilt's frame hull fills the space the arm could fold into, so
+arm cannot rest that way: a tilt-rotor's frame hull fills the space the arm could fold into, so
 its arm reaches below the frame and the robot, started level, tips onto two rim points and
 the arm (a 2.4 cm fall of the base, which the standing check counts as drift). This module
 lets the robot settle: a short MuJoCo run of the import's own collision geometry (the
@@ -78,7 +78,7 @@ def _servos(robot) -> list:
 def _principal(tensor) -> dict[str, str]:
     """MJCF `diaginertia` and `quat` of an inertia tensor (kg m^2, link axes): its principal
     moments, none below a speck (an inertia_decision may keep one that is not positive
-    definite, HyQ's base)."""
+    definite, a quadruped's base)."""
     from scipy.spatial.transform import Rotation
 
     moments, axes = np.linalg.eigh(np.asarray(tensor, dtype=float))

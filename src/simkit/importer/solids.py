@@ -1,6 +1,6 @@
 """Estimated solids for a floating robot whose URDF has no geometry at all.
 
-simple_humanoid_classical.urdf gives masses, CoMs and joints but neither `<visual>` nor
+A masses-only humanoid URDF gives masses, CoMs and joints but neither `<visual>` nor
 `<collision>`: the kit would have nothing to see and nothing to stand on, and it falls
 through the floor. Each link with a URDF mass gets a box in its own axes that bounds its
 origin, its child joints' origins and its CoM (so a limb spans from joint to joint and a foot

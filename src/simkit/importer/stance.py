@@ -1,8 +1,8 @@
 """A home pose free of self-contact for a floating-base import, feet left where they are.
 
 The importer's first guess at `home` is 0 for every joint (mid-range where 0 is outside).
-Humanoids often hang their arms through their thighs at 0 (Talos's grippers sit 7 cm inside
-its thigh hulls), so the kit's servos would hold a pose its own links penetrate and the
+Humanoids often hang their arms through their thighs at 0 (one humanoid's grippers sat 7 cm
+inside its thigh hulls), so the kit's servos would hold a pose its own links penetrate and the
 robot pushes itself over. This module measures self-contact with MuJoCo on the links'
 collision geometry as the spec gives it (primitives, the convex hull of each given collision
 mesh, else of each visual piece) with the kit's exclusions (links joined by a joint or welded
@@ -171,9 +171,9 @@ def _follow(q: np.ndarray, movable, index: dict[str, int]) -> np.ndarray:
 def _resting(q, support: Support, depth, movable, limits, index) -> np.ndarray:
     """The seeded random pose nearest `q` (joint-space distance) on which the robot rests
     (CoM at least MARGIN inside its support) with no more self-contact than `q`, resting on
-    its frame alone where a draw allows (Hextilt's arm servos, 0.3 N m, cannot carry it);
+    its frame alone where a draw allows (a tilt-rotor's arm servos, 0.3 N m, cannot carry it);
     `q` itself when none of them does. Random draws, not one joint at a time: a flying arm must move
-    two joints together to lift above its frame (Borinot)."""
+    two joints together to lift above its frame."""
     free = depth(q)
     lo, hi = np.array(limits, dtype=float).T
     draws = lo + np.random.default_rng(0).random((STABLE_SAMPLES, len(movable))) * (hi - lo)
@@ -199,8 +199,8 @@ def better(got, best) -> bool:
 def _pair_search(q, depth, robot, model, data, adr, always, frozen, limits, index):
     """For each link pair still in contact, the joints between them (distal first, the
     first PAIR_JOINTS not frozen) two at a time over a PAIR_GRID x PAIR_GRID grid of their
-    ranges: the pose with the least `depth`. iCub's shoulder clears its chest only with
-    pitch and roll moved together."""
+    ranges: the pose with the least `depth`. A humanoid's shoulder may clear its chest only
+    with pitch and roll moved together."""
     movable = robot.movable_joints
     best = depth(q)
     for pair in sorted(p for p in contacts(model, data, adr, q) if p not in always):
@@ -295,7 +295,7 @@ def free_home(robot, base_dir: Path, rest: bool = True) -> tuple[list[float], li
         if depth(q) > 0.0:  # two joints at once for the pairs one cannot part
             args = (robot, model, data, adr, always, feet, limits, index)
             q = _pair_search(q, depth, *args)
-        if depth(q) > 0.0:  # alike joints of all limbs together, feet kept level (HyQ)
+        if depth(q) > 0.0:  # alike joints of all limbs together, feet kept level (quadrupeds)
             q = _alike(q, depth, robot, index, movable)
         if depth(q) > 0.0:  # not free: the first guess stays
             q = start

@@ -36,7 +36,7 @@ def points(shape, base_dir: Path) -> np.ndarray:
 
 def lowest(shape, pose: np.ndarray, base_dir: Path) -> float:
     """World z (m) of a shape's lowest point with its link at `pose`: exact for round shapes
-    (a tilted shin cylinder's bounding-box corners reach below the cylinder: HyQ with its
+    (a tilted shin cylinder's bounding-box corners reach below the cylinder: a quadruped with its
     hips spread stood 1.7 cm above the floor), the lowest vertex or corner otherwise."""
     from simkit.model.kinematics import rpy_matrix
 
@@ -56,7 +56,7 @@ def lowest(shape, pose: np.ndarray, base_dir: Path) -> float:
 
 def floor_shapes(link) -> tuple:
     """What of a link can touch the floor in the kit: its collision primitives or given
-    collision shapes where the spec has them (HyQ's shin is a 2 cm cylinder inside a wider
+    collision shapes where the spec has them (a quadruped's shin is a 2 cm cylinder inside a wider
     visual mesh), else its visual solid (whose hull or pieces the kit collides)."""
     if link.collision_method == "primitives":
         return link.collision_primitives

@@ -2,7 +2,7 @@
 
 A link from a mesh file becomes a faceted solid in the STEP: one planar face, its loop,
 edges, plane and points per triangle, about 2.3 kB of STEP text per triangle (measured with
-Open CASCADE 7.8 on a Centauro knee: 3,478 triangles, 8.2 MB). A robot with 337,000 visual
+Open CASCADE 7.8 on a quadruped's knee: 3,478 triangles, 8.2 MB). A robot with 337,000 visual
 triangles would get a 790 MB STEP that takes minutes to write and re-check, over the kit's
 64 MiB per-file cap. Above `MAX_TRIANGLES` the importer writes `step: false` in the spec and
 says so on one line; the user can set it back to true.

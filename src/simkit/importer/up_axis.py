@@ -2,8 +2,8 @@
 
 COLLADA says a file whose `<up_axis>` is Y_UP has +Y up, so a Z-up world turns it +90 deg
 about x. ROS tools (RViz, MoveIt, Assimp-based loaders) ignore the tag, and most URDFs are
-drawn for them (Borinot, Hextilt, the ASR two-dof: their Y_UP meshes fit as stored). Some
-were drawn for a loader that honours it: iCub's meshes as stored lie across its links (the
+drawn for them (aerial manipulators, a two-dof arm: their Y_UP meshes fit as stored). Some
+were drawn for a loader that honours it: one humanoid's meshes as stored lie across its links (the
 shank along -z while the ankle joint sits 0.213 m along -x, where the turned shank ends),
 so its limbs interpenetrate and it cannot stand. The URDF's own numbers decide, for the
 whole file: the meshes are turned when that puts more child joint origins inside their

@@ -2,7 +2,7 @@
 
 A URDF's free joint is implicit, so the importer starts the base at the identity. Most
 legged robots are drawn Z-up, their limbs hanging along -z; a few are drawn Y-up
-(human.urdf, a biomechanics model: knees and ankles 0.44 m along -y, the spine along +y), and
+(a biomechanics model of a human body: knees and ankles 0.44 m along -y, the spine along +y), and
 at the identity they lie on their side and roll over. The limbs decide: from each branch
 leaving the base frame, the farthest end of its movable chains (a foot, a hand, the head: the
 CoM of the last link), summed in the base frame. Where that sum points along one axis

@@ -131,8 +131,9 @@ def _plain_text(name: str, text: str) -> None:
             raise SpecError(name, n, "<yaml>", f"control character {bad!r} is not allowed")
 
 
-#: libyaml's parser where PyYAML has it (G1's 2,800-line imported spec: 0.61 s -> 0.06 s of a
-#: 2 s warm rebuild); the same nodes, marks and errors as the pure-Python one otherwise
+#: libyaml's parser where PyYAML has it (a humanoid's 2,800-line imported spec: 0.61 s ->
+#: 0.06 s of a 2 s warm rebuild); the same nodes, marks and errors as the pure-Python one
+#: otherwise
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
