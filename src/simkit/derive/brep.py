@@ -252,13 +252,14 @@ def faceted_solid(mesh: Mesh) -> TopoDS_Shape:
     faces = np.asarray(mesh.faces, dtype=int)
     used, local = np.unique(faces.ravel(), return_inverse=True)
     points = np.asarray(mesh.vertices, dtype=float)[used] * MM
-    attempts = [(WELD_MM, False)] + [(weld, True) for weld in REPAIR_WELDS_MM]
-    for weld, repair in attempts:
-        nodes, triangles = _welded(points, local.reshape(-1, 3), weld, repair)
-        solid, whole = _closed_solid(nodes, triangles)
+    first, whole = _closed_solid(*_welded(points, local.reshape(-1, 3), WELD_MM, False))
+    if whole:
+        return first
+    for weld in REPAIR_WELDS_MM:
+        solid, whole = _closed_solid(*_welded(points, local.reshape(-1, 3), weld, True))
         if whole:
-            break
-    return solid
+            return solid
+    return first  # no repair made it whole: the plain weld, as before the repairs
 
 
 def _closed_solid(nodes: np.ndarray, triangles: np.ndarray) -> tuple[TopoDS_Shape, bool]:
