@@ -23,12 +23,8 @@ def split(text: str) -> tuple[str, list[tuple[int, str]], str]:
     """(text before the first entity, [(id, body)], text after the last entity's `;`)."""
     start = text.index("DATA;") + len("DATA;\n")
     end = text.index("ENDSEC;", start)
-    data = text[start:end]
-    marks = list(ENTITY.finditer(data))
-    entities = []
-    for i, mark in enumerate(marks):
-        stop = marks[i + 1].start() if i + 1 < len(marks) else len(data)
-        entities.append((int(mark.group(1)), data[mark.end() : stop]))
+    pieces = ENTITY.split(text[start:end])  # [before, id, body, id, body, ...], in C
+    entities = [(int(pieces[i]), pieces[i + 1]) for i in range(1, len(pieces), 2)]
     return text[:start], entities, text[end:]
 
 
@@ -104,7 +100,11 @@ def canonical_tail(text: str) -> str:
         eid = int(match.group(1))
         return f"#{renumber.get(eid, eid)}"
 
-    out = [f"#{eid} = {REF.sub(ref, body)}" for eid, body in entities[:first]]
+    geometry = entities[:first]
+    if tail.isdisjoint(map(int, REF.findall("".join(body for _, body in geometry)))):
+        out = [f"#{eid} = {body}" for eid, body in geometry]  # the usual case: as written
+    else:
+        out = [f"#{eid} = {REF.sub(ref, body)}" for eid, body in geometry]
     moved = {renumber[eid]: REF.sub(ref, bodies[eid]) for eid in tail_ids}
     out += [f"#{eid} = {moved[eid]}" for eid in sorted(moved)]
     return head + "".join(out) + foot
