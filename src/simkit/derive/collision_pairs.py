@@ -22,7 +22,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from simkit.model.kinematics import jointed_pairs, quat_wxyz, rpy_matrix
+from simkit.model.kinematics import contracted_pairs, jointed_pairs, quat_wxyz, rpy_matrix
 from simkit.model.robot import Link, Robot, Shape
 
 SAMPLES = 10_000
@@ -51,20 +51,8 @@ def has_geometry(link: Link) -> bool:
 def adjacent_pairs(robot: Robot) -> list[tuple[str, str]]:
     """Pairs of links with collision geometry joined by a joint, or by a chain of links and
     frames without geometry (MoveIt Setup Assistant's connection graph), sorted."""
-    neighbours: dict[str, set[str]] = {}
-    for joint in robot.joints:
-        neighbours.setdefault(joint.parent, set()).add(joint.child)
-        neighbours.setdefault(joint.child, set()).add(joint.parent)
     solid = {link.name for link in robot.links if has_geometry(link)}
-    for node in sorted(set(neighbours) - solid):  # contract geometry-less nodes
-        around = neighbours.pop(node)
-        for other in around:
-            neighbours[other].discard(node)
-        for a, b in itertools.combinations(sorted(around), 2):
-            neighbours[a].add(b)
-            neighbours[b].add(a)
-    pairs = {tuple(sorted((a, b))) for a in solid for b in neighbours.get(a, ()) if b in solid}
-    return sorted(pairs)  # type: ignore[arg-type]
+    return sorted(contracted_pairs(((j.parent, j.child) for j in robot.joints), solid))
 
 
 def sampled_joints(robot: Robot) -> list[tuple[str, float, float]]:

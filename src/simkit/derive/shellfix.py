@@ -16,11 +16,12 @@ from collections import defaultdict
 
 import numpy as np
 
+from simkit.model.robot import edge_uses
+
 
 def over_shared(triangles: np.ndarray) -> bool:
     """True when an edge is shared by more than two triangles."""
-    edges = np.sort(triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    return bool(len(edges)) and int(np.unique(edges, axis=0, return_counts=True)[1].max()) > 2
+    return bool(len(triangles)) and int(edge_uses(triangles).max()) > 2
 
 
 def unpinched(points: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

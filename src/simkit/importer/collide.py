@@ -11,12 +11,13 @@ Lengths in m, angles in rad, poses in spec order (`robot.movable_joints`).
 
 from __future__ import annotations
 
-import itertools
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
+
+from simkit.model.kinematics import contracted_pairs
 
 #: m: the clearance the chosen pose keeps between non-adjacent links (the kit's collision
 #: pieces are grown a little to cover the visual mesh)
@@ -68,19 +69,8 @@ def covered_shapes(link) -> tuple:
 
 def adjacent(robot) -> set[tuple[str, str]]:
     """Links joined by a joint, or through links without geometry (the kit's exclusions)."""
-    near: dict[str, set[str]] = {}
-    for joint in robot.joints:
-        near.setdefault(joint.parent, set()).add(joint.child)
-        near.setdefault(joint.child, set()).add(joint.parent)
     solid = {link.name for link in robot.links if collision_shapes(link)}
-    for node in sorted(set(near) - solid):
-        around = near.pop(node)
-        for other in around:
-            near[other].discard(node)
-        for a, b in itertools.combinations(sorted(around), 2):
-            near[a].add(b)
-            near[b].add(a)
-    return {tuple(sorted((a, b))) for a in solid for b in near.get(a, ()) if b in solid}
+    return contracted_pairs(((j.parent, j.child) for j in robot.joints), solid)
 
 
 def add_bodies(root: ET.Element, robot, base_dir: Path, shapes_of, geom) -> None:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.model.robot import canonical_triangles
+from simkit.model.robot import canonical_triangles, edge_uses
 
 #: COLLADA Y_UP to a Z-up frame: file (x, y, z) -> (x, -z, y)
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -81,9 +81,7 @@ def _edges_paired(faces: np.ndarray) -> bool:
     """True when every edge has an even number of triangles (two, or four where a solid
     touches itself): no other mesh can be wound into a closed manifold, so a CAD mesh with
     open edges goes straight to its hull without trimesh's slow winding walk."""
-    edges = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    _, counts = np.unique(edges, axis=0, return_counts=True)
-    return bool((counts % 2 == 0).all())
+    return bool((edge_uses(faces) % 2 == 0).all())
 
 
 def closed_solid(mesh) -> tuple[np.ndarray, np.ndarray, str]:

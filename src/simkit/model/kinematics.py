@@ -7,7 +7,8 @@ transform, exactly as URDF defines it.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import itertools
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -162,6 +163,25 @@ def chain(robot: Robot, base: str, tip: str) -> list[Joint]:
         out.append(joint)
         node = joint.parent
     return out[::-1]
+
+
+def contracted_pairs(joined: Iterable[tuple[str, str]], solid: set[str]) -> set[tuple[str, str]]:
+    """Pairs (sorted names) of `solid` links joined by a joint, or by a chain of links and
+    frames outside `solid` (MoveIt Setup Assistant's connection graph): `joined` holds each
+    joint's (parent, child); every node outside `solid` is contracted away, its neighbours
+    joined to each other."""
+    near: dict[str, set[str]] = {}
+    for parent, child in joined:
+        near.setdefault(parent, set()).add(child)
+        near.setdefault(child, set()).add(parent)
+    for node in sorted(set(near) - solid):
+        around = near.pop(node)
+        for other in around:
+            near[other].discard(node)
+        for a, b in itertools.combinations(sorted(around), 2):
+            near[a].add(b)
+            near[b].add(a)
+    return {(min(a, b), max(a, b)) for a in solid for b in near.get(a, ()) if b in solid}
 
 
 def jointed_pairs(robot: Robot) -> list[tuple[str, str]]:

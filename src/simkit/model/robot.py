@@ -82,6 +82,13 @@ def canonical_triangles(faces: np.ndarray) -> np.ndarray:
     return turned[np.lexsort(turned.T[::-1])]
 
 
+def edge_uses(faces: np.ndarray) -> np.ndarray:
+    """How many triangles use each edge (by vertex index, either direction): one count per
+    distinct edge. A closed manifold has 2 everywhere; 4 is a solid touching itself."""
+    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    return np.unique(edges, axis=0, return_counts=True)[1]
+
+
 @dataclass(frozen=True)
 class InertiaDecision:
     """A recorded decision to keep a non-physical reported inertia (spec_sim.py): the reported
