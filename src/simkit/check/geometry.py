@@ -40,10 +40,10 @@ def _hull_outside(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     whose cross-product normal can tilt by tens of degrees, so a plane through one of them
     cuts the piece and reports a true convex piece as 0.1 m off (a 7-dof arm's upper link in
     the corpus)."""
-    from scipy.spatial import ConvexHull, QhullError
+    from scipy.spatial import QhullError
 
     try:
-        planes = ConvexHull(np.asarray(vertices, dtype=float)).equations
+        planes = facet_planes(vertices).equations
     except (QhullError, ValueError):  # flat or too few points: no solid, nothing inside it
         return np.full(len(points), np.inf)
     return (points @ planes[:, :3].T + planes[:, 3]).max(axis=1)
