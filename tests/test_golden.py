@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from simkit.emit import docs, mjcf, robot_json, ros2, ros2_control, sdf, srdf, urdf
+from simkit.emit import docs, mjcf, mjcf_mjx, robot_json, ros2, ros2_control, sdf, srdf, urdf
 from simkit.kitio.jsonout import dumps
 from simkit.model.robot import SimReports
 from simkit.pipeline import model_from_spec
@@ -29,6 +29,7 @@ def _robot_json(robot) -> dict[str, bytes]:
 EMITTERS = {
     "urdf": urdf.emit,
     "mjcf": mjcf.emit,
+    "mjcf_mjx": mjcf_mjx.emit,
     "srdf": srdf.emit,
     "sdf": sdf.emit,
     "docs": docs.emit,

@@ -72,3 +72,14 @@ def test_a_bad_maintainer_email_is_a_one_line_spec_error(tmp_path):
     text = str(caught.value)
     assert "\n" not in text and "maintainer.email" in text
     assert f":{len(path.read_text().splitlines())}" in text  # the line of the bad field
+
+
+def test_a_spec_that_names_no_maintainer_on_purpose_builds_without_warning(tmp_path):
+    """`maintainer: unnamed` (no source names one) with a licence: no warning, and package.xml
+    keeps the placeholder maintainer; a spec that forgets still gets the warning."""
+    path = _spec(tmp_path, "maintainer: unnamed\nlicense: Apache-2.0\n")
+    robot = model_from_spec(str(path))
+    assert robot.maintainer is None and robot.maintainer_unnamed
+    assert ros2.package_warning(robot) is None
+    forgot = model_from_spec(str(_spec(tmp_path, "license: Apache-2.0\n")))
+    assert "no maintainer" in ros2.package_warning(forgot)

@@ -24,6 +24,7 @@ _REGISTRY: dict[str, str] = {
     "published": "published_numbers:check_published",
     "models": "mujoco:check_models",
     "mjcf_parameters": "mujoco:check_parameters",
+    "gpu_scene": "gpu_scene:check_gpu_scene",
     "urdf": "urdf:check_urdf",
     "collision": "geometry:check_collision",
     "glb": "geometry:check_glb",

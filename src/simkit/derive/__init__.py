@@ -8,7 +8,7 @@ from collections.abc import Callable
 from dataclasses import fields, replace
 from pathlib import Path
 
-from simkit.derive import arm, collision_pairs, mass, per_link, references, ros2_control
+from simkit.derive import arm, collision_pairs, gpu_scene, mass, per_link, references, ros2_control
 from simkit.kitio.cache import Cache, cached_stage, decode_plain, digest, encode_plain
 from simkit.model import dynamics
 from simkit.model.robot import Products, Robot
@@ -35,6 +35,7 @@ def derive_all(
     robot = ros2_control.derive_ros2_control(robot)  # spec `ros2_control:` only
     # last: both sample the final collision geometry, masses and servos
     robot = products_step(robot, cache, "collision_pairs", collision_pairs.derive_collision_pairs)
+    robot = products_step(robot, cache, "gpu_scene", gpu_scene.derive_gpu_scene)
     return products_step(robot, cache, "motion", arm.derive_motion)
 
 

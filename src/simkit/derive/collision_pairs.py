@@ -231,7 +231,7 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
 
     if not len(q):
         return []
-    q = _follow_mimics(robot, q)
+    q = follow_mimics(robot, q)
     need = math.ceil(ALWAYS_FRACTION * len(q) - 1e-9)
     skip = welded_pairs(robot) | {tuple(sorted(p)) for p in jointed_pairs(robot)}
     kit = {link.name for link in robot.links if _kit_collides(link)}
@@ -264,7 +264,7 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
     return sorted(p for p in candidates if count[p] >= need)
 
 
-def _follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
+def follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
     """`q` (sampled_joints order) with each mimic joint at its leader's value times the
     multiplier plus the offset, as the kit's MJCF equality holds it."""
     names = [name for name, _, _ in sampled_joints(robot)]

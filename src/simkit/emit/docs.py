@@ -10,7 +10,7 @@ import numpy as np
 
 from simkit.derive.ros2_control import controllers
 from simkit.derive.solids import CIRCULAR_SEGMENTS
-from simkit.emit import mjcf_world
+from simkit.emit import mjcf_world, robot_json
 from simkit.emit.step import step_origin
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
@@ -84,8 +84,23 @@ def context(robot: Robot) -> dict:
         "step_origin": step_origin(robot),
         "segments": CIRCULAR_SEGMENTS,
         **_floating(robot),
+        **_gpu(robot),
         **_fk_snippet(robot),
         **_page_extras(robot),
+    }
+
+
+def _gpu(robot: Robot) -> dict:
+    """Values for the README's GPU section (robot.json `gpu_scene`)."""
+    block = robot_json.gpu_scene(robot)
+    if block is None:
+        return {"gpu": None}
+    return {
+        "gpu": {
+            **block,
+            "floor_pairs": len(block["floor_pairs"]),
+            "self_pairs": block["pairs"] - len(block["floor_pairs"]),
+        }
     }
 
 

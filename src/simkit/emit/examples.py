@@ -1,4 +1,4 @@
-"""Quickstart scripts in the kit's examples/: mujoco_demo.py and pybullet_demo.py.
+"""Quickstart scripts in the kit's examples/: mujoco_demo.py, pybullet_demo.py, mjx_demo.py.
 
 They follow the kit page's "Quickstart" snippets, with paths taken relative to the script so
 they run from inside the kit folder (or anywhere) with only numpy plus mujoco or pybullet.
@@ -32,15 +32,18 @@ def _context(robot: Robot) -> dict:
         "mjcf": layout.mjcf(robot.name)
         if mjcf_world.servos_in_main(robot)
         else layout.mjcf_scene(robot.name),
+        "mjx": layout.mjcf_mjx(robot.name),
         "urdf": layout.urdf(robot.name),
         "target": [(name, num(v)) for name, v in zip(names, values, strict=True)],
     }
 
 
 def emit(robot: Robot) -> dict[str, bytes]:
-    """`examples/mujoco_demo.py` and `examples/pybullet_demo.py`."""
+    """`examples/mujoco_demo.py`, `examples/pybullet_demo.py` and, with a GPU scene,
+    `examples/mjx_demo.py`."""
     env, ctx = environment(), _context(robot)
     return {
         layout.example(name): env.get_template(f"examples/{name}.j2").render(ctx).encode("utf-8")
-        for name in ("mujoco_demo.py", "pybullet_demo.py")
+        for name in ("mujoco_demo.py", "pybullet_demo.py", "mjx_demo.py")
+        if name != "mjx_demo.py" or robot.products.gpu_scene is not None
     }

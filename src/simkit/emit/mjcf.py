@@ -7,6 +7,7 @@ kp = effort_peak per 0.01 rad, critically damped; collisions skipped between adj
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 
 import numpy as np
 
@@ -26,11 +27,12 @@ def _quat(rpy) -> str | None:
     return None if np.allclose(q, (1, 0, 0, 0), atol=0) else vec(q)
 
 
-def _mesh_name(link: str, index: int | None = None) -> str:
+def mesh_name(link: str, index: int | None = None) -> str:
     return link if index is None else f"{link}_collision_{index:02d}"
 
 
-def _primitive(parent: ET.Element, shape: Shape, name: str) -> None:
+def primitive(parent: ET.Element, shape: Shape, name: str) -> ET.Element:
+    """One collision primitive's `<geom>` (capsules by their end points)."""
     attrs = {"name": name, "class": shape.geom_class or "collision", "type": shape.kind}
     if shape.kind == "capsule":
         # end points, as the Asimov page writes its capsules (001_71a395c46b8a5939.txt,
@@ -38,8 +40,7 @@ def _primitive(parent: ET.Element, shape: Shape, name: str) -> None:
         half = rpy_matrix(shape.rpy) @ np.array([0.0, 0.0, shape.length / 2])
         ends = np.concatenate([np.asarray(shape.xyz) - half, np.asarray(shape.xyz) + half])
         attrs.update(size=num(shape.radius), fromto=vec(ends))
-        sub(parent, "geom", attrs)
-        return
+        return sub(parent, "geom", attrs)
     if shape.kind == "box":
         attrs["size"] = vec(np.asarray(shape.size) / 2)
     elif shape.kind == "sphere":
@@ -48,7 +49,7 @@ def _primitive(parent: ET.Element, shape: Shape, name: str) -> None:
         attrs["size"] = vec((shape.radius, shape.length / 2))
     attrs["pos"] = vec(shape.xyz)
     attrs["quat"] = _quat(shape.rpy)
-    sub(parent, "geom", attrs)
+    return sub(parent, "geom", attrs)
 
 
 def _assets(robot: Robot, mujoco: ET.Element) -> None:
@@ -61,14 +62,14 @@ def _assets(robot: Robot, mujoco: ET.Element) -> None:
             sub(
                 asset,
                 "mesh",
-                name=_mesh_name(link.name),
+                name=mesh_name(link.name),
                 file=layout.visual_mesh(link.name).removeprefix(meshdir),
             )
         for i in range(len(link.collision)):
             sub(
                 asset,
                 "mesh",
-                name=_mesh_name(link.name, i),
+                name=mesh_name(link.name, i),
                 file=layout.collision_mesh(link.name, i).removeprefix(meshdir),
             )
     mjcf_world.assets(robot, asset)
@@ -82,7 +83,7 @@ def _geoms(body: ET.Element, link: Link) -> None:
             {
                 "name": f"{link.name}_visual",
                 "class": "visual",
-                "mesh": _mesh_name(link.name),
+                "mesh": mesh_name(link.name),
                 "material": link.material,
             },
         )
@@ -90,7 +91,7 @@ def _geoms(body: ET.Element, link: Link) -> None:
         # one primitive: `LINK_collision`, the Asimov page's name (left_knee_link_collision)
         single = len(link.collision_primitives) == 1
         for i, shape in enumerate(link.collision_primitives):
-            _primitive(body, shape, f"{link.name}_collision" + ("" if single else f"_{i:02d}"))
+            primitive(body, shape, f"{link.name}_collision" + ("" if single else f"_{i:02d}"))
     elif link.collision:
         for i in range(len(link.collision)):
             sub(
@@ -99,7 +100,7 @@ def _geoms(body: ET.Element, link: Link) -> None:
                 {
                     "name": f"{link.name}_collision_{i:02d}",
                     "class": "collision",
-                    "mesh": _mesh_name(link.name, i),
+                    "mesh": mesh_name(link.name, i),
                 },
             )
     elif link.solid is not None:
@@ -109,26 +110,32 @@ def _geoms(body: ET.Element, link: Link) -> None:
             {
                 "name": f"{link.name}_collision_00",
                 "class": "collision",
-                "mesh": _mesh_name(link.name),
+                "mesh": mesh_name(link.name),
             },
         )
 
 
-def _body(robot: Robot, parent: ET.Element, link_name: str) -> None:
+GeomWriter = Callable[[ET.Element, Link], None]
+
+
+def body(robot: Robot, parent: ET.Element, link_name: str, geoms: GeomWriter | None = None) -> None:
+    """The link's `<body>` and its subtree: inertial, joint, geoms (`geoms`, the main
+    file's by default), sites, cameras, child bodies."""
+    geoms = geoms or _geoms
     link = robot.link(link_name)
     joint = robot.parent_joint(link_name)
-    body = sub(parent, "body", name=link.name, pos=vec(joint.xyz), quat=_quat(joint.rpy))
+    element = sub(parent, "body", name=link.name, pos=vec(joint.xyz), quat=_quat(joint.rpy))
     if link.inertial is not None:
         ixx, iyy, izz, ixy, ixz, iyz = link.inertial.inertia
         sub(
-            body,
+            element,
             "inertial",
             pos=vec(link.inertial.com),
             mass=num(link.inertial.mass),
             fullinertia=vec((ixx, iyy, izz, ixy, ixz, iyz)),
         )
     if joint.type == "floating":
-        sub(body, "freejoint", name=joint.name)
+        sub(element, "freejoint", name=joint.name)
     elif joint.movable:
         attrs = {
             "name": joint.name,
@@ -144,28 +151,27 @@ def _body(robot: Robot, parent: ET.Element, link_name: str) -> None:
             attrs["stiffness"] = num(joint.stiffness)
             attrs["springref"] = num(joint.springref)
         mjcf_world.joint_extras(joint, attrs)
-        sub(body, "joint", attrs)
-    _geoms(body, link)
+        sub(element, "joint", attrs)
+    geoms(element, link)
     for frame in robot.frames:
         if frame.parent == link.name:
             sub(
-                body,
+                element,
                 "site",
                 name=frame.name,
                 pos=vec(frame.xyz),
                 quat=_quat(frame.rpy),
                 size=num(frame.site_size) if frame.site_size else "0.005",
             )
-    mjcf_world.cameras(robot, body, link.name)
+    mjcf_world.cameras(robot, element, link.name)
     for child in robot.joints:
         if child.parent == link.name:
-            _body(robot, body, child.child)
+            body(robot, element, child.child, geoms)
 
 
-def emit(robot: Robot) -> dict[str, bytes]:
-    """`mjcf/NAME.xml`."""
-    file = layout.mjcf(robot.name)
-    mujoco = ET.Element("mujoco", model=robot.name)
+def head(robot: Robot, model: str, file: str, option: dict[str, str] | None = None) -> ET.Element:
+    """`<mujoco>` with compiler, option (plus `option`), visual and the default classes."""
+    mujoco = ET.Element("mujoco", model=model)
     sub(
         mujoco,
         "compiler",
@@ -178,42 +184,51 @@ def emit(robot: Robot) -> dict[str, bytes]:
         "option",
         timestep=num(mjcf_world.timestep(robot, TIMESTEP)),
         integrator="implicitfast",
+        **(option or {}),
     )
     mjcf_world.visual(robot, mujoco)
+    return mujoco
+
+
+def defaults(robot: Robot, mujoco: ET.Element) -> dict[str, ET.Element]:
+    """The robot's default class with `visual` and `collision` (and the spec's classes)."""
     default = sub(sub(mujoco, "default"), "default", {"class": robot.name})
     visual = sub(default, "default", {"class": "visual"})
     sub(visual, "geom", type="mesh", contype="0", conaffinity="0", group="2")
     collision = sub(default, "default", {"class": "collision"})
     sub(collision, "geom", type="mesh", group="3")
     mjcf_world.defaults(robot, default, {"visual": visual, "collision": collision})
-    _assets(robot, mujoco)
-    world = sub(mujoco, "worldbody")
-    if not mjcf_world.world(robot, world):
-        sub(world, "light", name="top", pos="0 0 3", dir="0 0 -1", directional="true")
+    return {"visual": visual, "collision": collision}
+
+
+def world(robot: Robot, mujoco: ET.Element, geoms: GeomWriter | None = None) -> ET.Element:
+    """`<worldbody>`: lights, floor, root sites and the body tree (with `geoms`)."""
+    worldbody = sub(mujoco, "worldbody")
+    if not mjcf_world.world(robot, worldbody):
+        sub(worldbody, "light", name="top", pos="0 0 3", dir="0 0 -1", directional="true")
     for frame in robot.frames:
         if frame.parent == robot.root:
-            sub(world, "site", name=frame.name, pos=vec(frame.xyz), quat=_quat(frame.rpy))
-    wrapper = world
+            sub(worldbody, "site", name=frame.name, pos=vec(frame.xyz), quat=_quat(frame.rpy))
     for joint in robot.joints:
         if joint.parent == robot.root:
-            _body(robot, wrapper, joint.child)
-    for body in world.iter("body"):
-        if body.get("childclass") is None and body in list(world):
-            body.set("childclass", robot.name)
-    contact = sub(mujoco, "contact")
-    for a, b in jointed_pairs(robot):
-        sub(contact, "exclude", body1=a, body2=b)
-    for a, b in (robot.products.collision_pairs or {}).get("always", []):
-        sub(contact, "exclude", body1=a, body2=b)  # in contact in every configuration
+            body(robot, worldbody, joint.child, geoms)
+    for top in worldbody.iter("body"):
+        if top.get("childclass") is None and top in list(worldbody):
+            top.set("childclass", robot.name)
+    return worldbody
+
+
+def equality(robot: Robot, mujoco: ET.Element) -> None:
+    """`<equality>`: one joint equality per mimic joint (MIMIC_* below)."""
     mimics = [j for j in robot.joints if j.mimic is not None]
     if mimics:
-        equality = sub(mujoco, "equality")
+        element = sub(mujoco, "equality")
         solref = vec((MIMIC_TIMECONST_STEPS * mjcf_world.timestep(robot, TIMESTEP), 1.0))
         for joint in mimics:
             leader, multiplier, offset = joint.mimic  # type: ignore[misc]
             polycoef = vec((offset, multiplier, 0.0, 0.0, 0.0))
             sub(
-                equality,
+                element,
                 "joint",
                 joint1=joint.name,
                 joint2=leader,
@@ -221,6 +236,21 @@ def emit(robot: Robot) -> dict[str, bytes]:
                 solref=solref,
                 solimp=vec(MIMIC_SOLIMP),
             )
+
+
+def emit(robot: Robot) -> dict[str, bytes]:
+    """`mjcf/NAME.xml`."""
+    file = layout.mjcf(robot.name)
+    mujoco = head(robot, robot.name, file)
+    defaults(robot, mujoco)
+    _assets(robot, mujoco)
+    world(robot, mujoco)
+    contact = sub(mujoco, "contact")
+    for a, b in jointed_pairs(robot):
+        sub(contact, "exclude", body1=a, body2=b)
+    for a, b in (robot.products.collision_pairs or {}).get("always", []):
+        sub(contact, "exclude", body1=a, body2=b)  # in contact in every configuration
+    equality(robot, mujoco)
     mjcf_world.sensors(robot, mujoco)
     if mjcf_world.servos_in_main(robot):
         actuators(robot, mujoco)

@@ -31,6 +31,20 @@ def key_qpos(robot: Robot, q: tuple[float, ...]) -> list[float]:
     return out + [float(v) for v in q]
 
 
+def keyframes(robot: Robot, mujoco: ET.Element) -> None:
+    """`<keyframe>`: one key per named pose, the servos' targets at the pose."""
+    if not robot.poses:
+        return
+    keyframe = sub(mujoco, "keyframe")
+    names = [j.name for j in robot.movable_joints]
+    for pose, q in robot.poses:
+        values = dict(zip(names, q, strict=True))
+        attrs = {"name": pose, "qpos": vec(key_qpos(robot, q))}
+        if robot.actuators:
+            attrs["ctrl"] = vec(values[a.joint] for a in robot.actuators)
+        sub(keyframe, "key", attrs)
+
+
 def emit(robot: Robot) -> dict[str, bytes]:
     """`mjcf/NAME_scene.xml`, or nothing when the servos live in the main file."""
     if mjcf_world.servos_in_main(robot):
@@ -39,13 +53,5 @@ def emit(robot: Robot) -> dict[str, bytes]:
     mujoco = ET.Element("mujoco", model=f"{robot.name}_scene")
     sub(mujoco, "include", file=layout.relative(file, main))
     mjcf.actuators(robot, mujoco)
-    if robot.poses:
-        keyframe = sub(mujoco, "keyframe")
-        names = [j.name for j in robot.movable_joints]
-        for pose, q in robot.poses:
-            values = dict(zip(names, q, strict=True))
-            attrs = {"name": pose, "qpos": vec(key_qpos(robot, q))}
-            if robot.actuators:
-                attrs["ctrl"] = vec(values[a.joint] for a in robot.actuators)
-            sub(keyframe, "key", attrs)
+    keyframes(robot, mujoco)
     return {file: to_bytes(mujoco, HEADER.format(spec=robot.spec_file, main=main))}

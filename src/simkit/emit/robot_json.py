@@ -134,6 +134,7 @@ def document(robot: Robot, reports: SimReports) -> dict:
         "files": {
             "urdf": layout.urdf(robot.name),
             "mjcf": layout.mjcf(robot.name),
+            "mjcf_mjx": layout.mjcf_mjx(robot.name),
             "glb": layout.glb(robot.name),
         },
         "base_frame": products.base_frame or robot.root,
@@ -216,12 +217,37 @@ def _products(robot: Robot, reports: SimReports) -> dict:
         "ros2_control": p.ros2_control,
         "urdf_blocks": [urdf_blocks.summary(b) for b in robot.urdf_blocks] or None,
         "collision_pairs": p.collision_pairs,
+        "gpu_scene": gpu_scene(robot),
         "ik_reference": p.ik_reference,
         "motion": p.motion,
         "benchmarks": _benchmarks(robot, reports),
         "validation": {"freefall": reports.freefall["record"]} if reports.freefall else None,
     }
     return {key: value for key, value in out.items() if value is not None}
+
+
+def gpu_scene(robot: Robot) -> dict | None:
+    """robot.json `gpu_scene`: the GPU scene's file, contact budget and sizes (the plan's
+    colliders stay in the file itself)."""
+    plan = robot.products.gpu_scene
+    if plan is None:
+        return None
+    out = {
+        "file": layout.mjcf_mjx(robot.name),
+        "contact_slots": plan["contact_slots"],
+        "pair_slots": plan["pair_slots"],
+        "pairs": len(plan["pairs"]) + len(plan["floor_pairs"]),  # explicit pairs, floor ones too
+        "floor_pairs": plan["floor_pairs"],
+        "nconmax": plan["nconmax"],
+        "njmax": plan["njmax"],
+        "solver": {"iterations": plan["iterations"], "ls_iterations": plan["ls_iterations"]},
+        "method": plan["method"],
+        "seed": plan["seed"],
+        "samples": plan["samples"],
+    }
+    if "note" in plan:
+        out["note"] = plan["note"]
+    return out
 
 
 def _benchmarks(robot: Robot, reports: SimReports) -> dict | None:

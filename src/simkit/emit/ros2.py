@@ -59,13 +59,15 @@ def default_license(robot: Robot) -> str:
 def package_warning(robot: Robot) -> str | None:
     """One line when the spec leaves package.xml's maintainer or licence to the defaults."""
     missing = [k for k in ("maintainer", "license") if getattr(robot, k) is None]
+    if robot.maintainer_unnamed:
+        missing.remove("maintainer")
     if not missing:
         return None
     name, email = robot.maintainer or DEFAULT_MAINTAINER
     return (
         f"{robot.spec_file} gives no {' or '.join(missing)}: package.xml names "
         f"'{name} <{email}>' and licence '{robot.license or default_license(robot)}' "
-        "(set `maintainer: {name, email}` and `license:` in the spec)"
+        "(set `maintainer: {name, email}` (or `unnamed`) and `license:` in the spec)"
     )
 
 

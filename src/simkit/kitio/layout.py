@@ -36,6 +36,11 @@ def mjcf_scene(robot: str) -> str:
     return f"mjcf/{robot}_scene.xml"
 
 
+def mjcf_mjx(robot: str) -> str:
+    """The GPU scene for MJX and MuJoCo Warp (emit/mjcf_mjx.py)."""
+    return f"mjcf/{robot}_mjx.xml"
+
+
 def srdf(robot: str) -> str:
     return f"srdf/{robot}.srdf"
 

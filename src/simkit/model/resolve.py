@@ -220,6 +220,7 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         urdf_blocks=spec.urdf_blocks,
         freefall=spec.freefall,
         maintainer=(spec.maintainer.name, spec.maintainer.email) if spec.maintainer else None,
+        maintainer_unnamed=spec.maintainer_unnamed,
         license=spec.license,
         source=None if spec.source is None else (spec.source.file, spec.source.sha256),
         source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),

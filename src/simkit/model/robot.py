@@ -250,6 +250,8 @@ class Products:
     benchmarks: dict | None = None
     benchmark_cycles: dict = field(default_factory=dict)
     benchmark_trajectory: dict | None = None
+    #: derive/gpu_scene.py: the GPU scene's colliders, contact pairs and sizes (mjcf/NAME_mjx.xml)
+    gpu_scene: dict | None = None
 
 
 @dataclass(frozen=True)
@@ -304,6 +306,8 @@ class Robot:
     urdf_blocks: tuple[str, ...] = ()
     #: package.xml: the spec's maintainer (name, email) and licence, or None (ros2.py defaults)
     maintainer: tuple[str, str] | None = None
+    #: the spec says no source names a maintainer (`maintainer: unnamed`): no warning
+    maintainer_unnamed: bool = False
     license: str | None = None
     #: an import's kept source: (file name beside the spec, SHA-256), or None
     source: tuple[str, str] | None = None

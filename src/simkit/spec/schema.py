@@ -336,6 +336,14 @@ class SourceDifference(Strict):
 class RobotSpec(Strict):
     """The whole robot spec (one YAML file)."""
 
+    @model_validator(mode="before")
+    @classmethod
+    def _unnamed_maintainer(cls, data: object) -> object:
+        """`maintainer: unnamed`: no source names one (package.xml keeps the default)."""
+        if isinstance(data, dict) and data.get("maintainer") == "unnamed":
+            return {**data, "maintainer": None, "maintainer_unnamed": True}
+        return data
+
     name: Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$")]
     title: str
     description: str = ""
@@ -369,8 +377,11 @@ class RobotSpec(Strict):
     #: written into the kit's URDF verbatim after the joints (spec/urdf_blocks.py)
     urdf_blocks: tuple[str, ...] = ()
     #: package.xml `<maintainer>` and `<license>` (an SPDX expression, e.g. "Apache-2.0");
-    #: without them the ROS 2 package gets emit/ros2.py's defaults and the build a warning
+    #: without them the ROS 2 package gets emit/ros2.py's defaults and the build a warning.
+    #: `maintainer: unnamed` says that no source names one (the default, without the warning)
     maintainer: MaintainerSpec | None = None
+    #: set by `maintainer: unnamed` (see `_unnamed_maintainer`), not written by hand
+    maintainer_unnamed: bool = False
     license: Annotated[str, Field(min_length=1, pattern=r"^[^\n]+$")] | None = None
     #: the imported source file and its digest, and the kit's intended differences from it
     source: SourceSpec | None = None

@@ -1,0 +1,435 @@
+"""The GPU scene's plan (`mjcf/NAME_mjx.xml`, issue 30): primitive colliders, explicit contact
+pairs and solver settings for MJX and MuJoCo Warp; bodies, masses, joints and servos stay the
+main MJCF's.
+
+Why a second file: MJX and MuJoCo Warp give every geom pair that may touch static contact
+slots, and collide convex meshes slowly (MJX documentation, "Performance tuning"); the main
+MJCF keeps the kit page's rules (only adjacent links excluded, up to ten convex pieces a link).
+Menagerie's `*_mjx.xml` files and MuJoCo Playground's variants do the same.
+
+Colliders, per link (`colliders`):
+- the spec's collision primitives, as in the main MJCF;
+- a union of convex primitives (one `convex` piece per primitive): each primitive itself; a
+  cone becomes the smallest cylinder that covers it;
+- any other piece (CoACD, given hulls): the kit's own OBJ piece, its hull capped at
+  `MAX_HULL_VERTICES` vertices (MuJoCo's `maxhullvert`).
+MJX collides cylinders only with planes, spheres, capsules and cylinders: against a box or a
+mesh, a cylinder's circumscribed box stands in for it (in that pair only), so no collider
+turns into a mesh (MJX compiles one collision function per distinct mesh pair).
+
+Pairs (`contact pairs`): the collider pairs in contact in any of the seeded configurations the
+SRDF's sampling draws (derive/collision_pairs.py), except the link pairs the main MJCF never
+collides (joined by a joint, welded, always in contact). A floating base also stands on a
+floor: the colliders within `FOOT_BAND` of the lowest point at home pair with it, less those
+whose core lies in the convex hull of a neighbour's core on the same link (a plane can never
+reach them first).
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import replace
+
+import numpy as np
+
+from simkit.derive.collision import MAX_PIECES
+from simkit.derive.collision_pairs import (
+    configurations,
+    follow_mimics,
+    sampled_joints,
+    welded_pairs,
+)
+from simkit.derive.solids import is_convex_union
+from simkit.model.kinematics import jointed_pairs, quat_wxyz, rpy_matrix
+from simkit.model.robot import Link, Robot, Shape
+
+#: MJX's guidance: fewer than 32 vertices for convex-convex collisions
+MAX_HULL_VERTICES = 24
+#: m: colliders this close above the lowest point at home stand on the floor
+FOOT_BAND = 0.02
+#: solver settings for batched simulation: Newton with few iterations (the issue's measured
+#: Asimov variant: iterations 4, line search 8; MJX's own humanoid uses 1 and 4)
+ITERATIONS = 4
+LS_ITERATIONS = 8
+#: contact slots a pair takes in MJX (mujoco-mjx 3.17 collision functions' `ncon`), by the
+#: two MuJoCo geom types in MuJoCo's order; `mesh` stands for pieces
+MJX_CONTACTS = {
+    ("plane", "sphere"): 1,
+    ("plane", "capsule"): 2,
+    ("plane", "box"): 4,
+    ("plane", "cylinder"): 3,
+    ("plane", "mesh"): 4,
+    ("sphere", "sphere"): 1,
+    ("sphere", "capsule"): 1,
+    ("sphere", "cylinder"): 1,
+    ("sphere", "box"): 1,
+    ("sphere", "mesh"): 1,
+    ("capsule", "capsule"): 1,
+    ("capsule", "box"): 2,
+    ("capsule", "cylinder"): 2,
+    ("capsule", "mesh"): 2,
+    ("cylinder", "cylinder"): 4,
+    ("box", "box"): 4,
+    ("box", "mesh"): 4,
+    ("mesh", "mesh"): 4,
+}
+TYPE_ORDER = ("plane", "sphere", "capsule", "cylinder", "box", "mesh")
+#: a target for contact slots per world; a robot over it says so in one line (robot.json)
+SLOT_TARGET = 64
+#: constraint rows per contact: condim 3 in a pyramidal cone (MuJoCo's defaults)
+ROWS_PER_CONTACT = 4
+TOUCH = 1e-6  # m: margin of the sampled contacts (faces that meet exactly count)
+#: the floor's name in pairs when the spec names none
+FLOOR = "floor"
+#: m: a sampled configuration penetrating no deeper than this only touches
+TOUCHING_DEPTH = 0.005
+
+
+METHOD = (
+    "colliders: the spec's primitives (a cone as the cylinder that covers it; a cylinder's "
+    "circumscribed box where it meets a box or a mesh), other pieces with at most "
+    f"{MAX_HULL_VERTICES} hull vertices; pairs: the collider pairs in contact in any of "
+    "`samples` configurations drawn as for collision_pairs (seed `seed`), less the pairs the "
+    "main MJCF never collides; floor pairs (floating base): colliders within "
+    f"{FOOT_BAND} m of the lowest point at home whose core no neighbour's covers; "
+    "contact_slots: MJX slots of the floor pairs plus twice the most in use at once in a "
+    f"sampled configuration that penetrates under {TOUCHING_DEPTH} m (MJX max_contact_points "
+    f"keeps the deepest), at most pair_slots; njmax: {ROWS_PER_CONTACT} rows a contact plus "
+    "joint limits, friction loss and mimics"
+)
+
+
+def mujoco_type(kind: str) -> str:
+    """The MuJoCo geom type of a collider kind (pieces are meshes)."""
+    return "mesh" if kind == "piece" else kind
+
+
+def _primitive(link: Link, shape: Shape, name: str) -> dict:
+    out = {"link": link.name, "name": name, "kind": shape.kind, "class": shape.geom_class}
+    out["xyz"], out["rpy"] = [float(v) for v in shape.xyz], [float(v) for v in shape.rpy]
+    if shape.kind == "box":
+        out["size"] = [float(v) for v in shape.size]  # full edge lengths (m)
+    else:
+        out["radius"] = float(shape.radius)
+        if shape.kind in ("capsule", "cylinder", "cone"):
+            out["length"] = float(shape.length)
+        if shape.kind == "cone":
+            out["radius_top"] = float(shape.radius_top)
+    return out
+
+
+def colliders(link: Link) -> list[dict]:
+    """The link's GPU colliders (names as the main MJCF's collision geoms)."""
+    if link.collision_primitives:
+        single = len(link.collision_primitives) == 1
+        return [
+            _primitive(link, s, f"{link.name}_collision" + ("" if single else f"_{i:02d}"))
+            for i, s in enumerate(link.collision_primitives)
+        ]
+    if link.collision_method == "primitives":
+        return []
+    shapes = link.shapes
+    if is_convex_union(shapes) and len(shapes) <= MAX_PIECES and len(link.collision) == len(shapes):
+        out = [_primitive(link, s, f"{link.name}_collision_{i:02d}") for i, s in enumerate(shapes)]
+        for geom in out:
+            if geom["kind"] == "cone":  # the smallest cylinder that covers it
+                geom["kind"] = "cylinder"
+                geom["radius"] = max(geom["radius"], geom.pop("radius_top"))
+        return out
+    pieces = link.collision or ((link.solid,) if link.solid is not None else ())
+    return [
+        {"link": link.name, "name": f"{link.name}_collision_{i:02d}", "kind": "piece", "piece": i}
+        for i in range(len(pieces))
+    ]
+
+
+def piece_vertices(robot: Robot, geom: dict) -> np.ndarray:
+    """A piece's vertices (link frame, m): the kit's collision piece, or the visual solid."""
+    link = robot.link(geom["link"])
+    pieces = link.collision or (link.solid,)
+    return np.asarray(pieces[geom["piece"]].vertices)
+
+
+# --- the scratch model: colliders on the robot's bodies, for sampling and the stance ------
+
+
+def _text(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+def _scratch_geom(robot: Robot, asset: ET.Element, body: ET.Element, geom: dict) -> None:
+    attrs = {"name": geom["name"]}
+    kind = geom["kind"]
+    if kind == "piece":
+        vertices = piece_vertices(robot, geom)
+        mesh = {"name": geom["name"], "vertex": _text(vertices)}
+        if len(vertices) > MAX_HULL_VERTICES:
+            mesh["maxhullvert"] = str(MAX_HULL_VERTICES)
+        ET.SubElement(asset, "mesh", mesh)
+        attrs.update(type="mesh", mesh=geom["name"])
+    else:
+        attrs.update(pos=_text(geom["xyz"]), quat=_text(quat_wxyz(rpy_matrix(geom["rpy"]))))
+        if kind == "box":
+            attrs.update(type="box", size=_text(np.asarray(geom["size"]) / 2))
+        elif kind == "sphere":
+            attrs.update(type="sphere", size=_text([geom["radius"]]))
+        else:  # capsule, cylinder: radius and half-length along local z
+            attrs.update(type=kind, size=_text([geom["radius"], geom["length"] / 2]))
+    ET.SubElement(body, "geom", attrs)
+
+
+def scratch_xml(robot: Robot, geoms: list[dict], skip: set[tuple[str, str]]) -> str:
+    """MJCF of the colliders on the robot's bodies at their joint origins (a floating base at
+    its spec origin, locked), every link pair but `skip` colliding, the parent filter off."""
+    root = ET.Element("mujoco", model=f"{robot.name}_gpu_pairs")
+    ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false")
+    ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable", gravity="disable")
+    default = ET.SubElement(root, "default")
+    ET.SubElement(default, "geom", contype="1", conaffinity="1", margin=repr(TOUCH / 2))
+    asset = ET.SubElement(root, "asset")
+    bodies = {robot.root: ET.SubElement(root, "worldbody")}
+    by_link: dict[str, list[dict]] = {}
+    for geom in geoms:
+        by_link.setdefault(geom["link"], []).append(geom)
+    for joint in robot.joints:
+        quat = quat_wxyz(rpy_matrix(joint.rpy))
+        body = ET.SubElement(
+            bodies[joint.parent], "body", name=joint.child, pos=_text(joint.xyz), quat=_text(quat)
+        )
+        bodies[joint.child] = body
+        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+        if joint.type in ("revolute", "continuous"):
+            ET.SubElement(body, "joint", name=joint.name, type="hinge", axis=_text(joint.axis))
+        elif joint.type == "prismatic":
+            ET.SubElement(body, "joint", name=joint.name, type="slide", axis=_text(joint.axis))
+        else:  # fixed and floating: held at the origin
+            ET.SubElement(body, "joint", name=f"{joint.name}_locked", type="slide")
+        for geom in by_link.get(joint.child, []):
+            _scratch_geom(robot, asset, body, geom)
+    contact = ET.SubElement(root, "contact")
+    for a, b in sorted(skip):
+        ET.SubElement(contact, "exclude", body1=a, body2=b)
+    return ET.tostring(root, encoding="unicode")
+
+
+def never_collided(robot: Robot) -> set[tuple[str, str]]:
+    """Link pairs the main MJCF never collides: joined by a joint, welded (MuJoCo's own
+    filters) and the `always` pairs it excludes; sorted name pairs."""
+    pairs = {tuple(sorted(p)) for p in jointed_pairs(robot)} | welded_pairs(robot)
+    always = (robot.products.collision_pairs or {}).get("always", [])
+    return pairs | {tuple(sorted(p)) for p in always}
+
+
+def sampled_contacts(robot: Robot, geoms: list[dict], q: np.ndarray) -> list[tuple[float, set]]:
+    """For each configuration of `q` with a contact: the deepest penetration (m) and the
+    collider pairs in contact (within `TOUCH`), as sorted name pairs."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(scratch_xml(robot, geoms, never_collided(robot)))
+    data = mujoco.MjData(model)
+    names = [j for j, _, _ in sampled_joints(robot)]
+    adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
+    geom_name = [model.geom(i).name for i in range(model.ngeom)]
+    out: list[tuple[float, set]] = []
+    for row in follow_mimics(robot, q) if len(names) else []:
+        data.qpos[adr] = row
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        if data.ncon:
+            geom = data.contact.geom[: data.ncon]
+            depth = float(max(0.0, -data.contact.dist[: data.ncon].min()))
+            out.append((depth, {tuple(sorted((geom_name[a], geom_name[b]))) for a, b in geom}))
+    return out
+
+
+def stand_ins(kinds: dict[str, str], pairs: list[list[str]]) -> dict[str, list[str]]:
+    """Cylinders that meet a box or a mesh, with those partners: MJX has no collision function
+    for such pairs, so there the cylinder's circumscribed box stands in for it."""
+    out: dict[str, list[str]] = {}
+    for a, b in pairs:
+        for x, y in ((a, b), (b, a)):
+            if kinds[x] == "cylinder" and mujoco_type(kinds.get(y, "plane")) in ("box", "mesh"):
+                out.setdefault(x, []).append(y)
+    return {k: sorted(v) for k, v in sorted(out.items())}
+
+
+def peak_slots(kinds: dict[str, str], contacts: list[tuple[float, set]], swaps: dict) -> int | None:
+    """The most contact slots in use at once in a sampled configuration that only touches
+    (deepest penetration under `TOUCHING_DEPTH`): a servo stops a robot that meets itself
+    there, so deeper configurations are never reached. None when no sample only touches."""
+    touching = [c for depth, c in contacts if depth <= TOUCHING_DEPTH]
+    if not touching:
+        return None
+    return max(sum(pair_slots(kinds, *p, swaps) for p in c) for c in touching)
+
+
+# --- the floor: what a floating base stands on ------------------------------------------
+
+
+def _home(robot: Robot) -> np.ndarray:
+    """The home pose (sampled-joint order): the spec's `home`, else zeros."""
+    names = [j.name for j in robot.movable_joints]
+    values = dict(zip(names, dict(robot.poses).get("home", (0.0,) * len(names)), strict=True))
+    return np.array([values.get(n, 0.0) for n, _, _ in sampled_joints(robot)], dtype=float)
+
+
+def _lowest(geom: dict, pos: np.ndarray, mat: np.ndarray, vertices: np.ndarray | None) -> float:
+    """Lowest world z (m) of a collider placed at `pos`, `mat` (MuJoCo's geom frame)."""
+    kind = geom["kind"]
+    if vertices is not None:
+        return float(np.min(vertices[:, 2]))
+    if kind == "sphere":
+        return float(pos[2] - geom["radius"])
+    axis_z = abs(mat[2, 2])
+    if kind == "capsule":
+        return float(pos[2] - axis_z * geom["length"] / 2 - geom["radius"])
+    if kind == "cylinder":
+        radial = geom["radius"] * math.sqrt(max(0.0, 1.0 - axis_z**2))
+        return float(pos[2] - axis_z * geom["length"] / 2 - radial)
+    half = np.asarray(geom["size"]) / 2  # box
+    return float(pos[2] - np.abs(mat[2]) @ half)
+
+
+def _cores(geom: dict) -> np.ndarray:
+    """A round collider's core in its link frame: a sphere's centre, a capsule's end points."""
+    centre = np.asarray(geom["xyz"], dtype=float)
+    if geom["kind"] == "sphere":
+        return centre[None]
+    half = rpy_matrix(geom["rpy"]) @ np.array([0.0, 0.0, geom["length"] / 2])
+    return np.stack([centre - half, centre + half])
+
+
+def _inside_hull(points: np.ndarray, cloud: np.ndarray) -> bool:
+    """Whether every point lies in the convex hull of `cloud` (a linear feasibility test,
+    exact for flat and collinear clouds too)."""
+    from scipy.optimize import linprog
+
+    if not len(cloud):
+        return False
+    a_eq = np.vstack([cloud.T, np.ones(len(cloud))])
+    for point in points:
+        b_eq = np.append(point, 1.0)
+        result = linprog(np.zeros(len(cloud)), A_eq=a_eq, b_eq=b_eq, bounds=(0, None))
+        if result.status != 0:
+            return False
+    return True
+
+
+def _prune_shadowed(candidates: list[dict]) -> list[dict]:
+    """Drop round colliders whose core lies in the hull of the cores of the same link's other
+    kept round colliders of at least their radius: against a plane those reach as deep."""
+    kept = list(candidates)
+    for geom in candidates:
+        if geom["kind"] not in ("sphere", "capsule"):
+            continue
+        others = [
+            g
+            for g in kept
+            if g is not geom
+            and g["link"] == geom["link"]
+            and g["kind"] in ("sphere", "capsule")
+            and g["radius"] >= geom["radius"] - 1e-12
+        ]
+        cloud = np.concatenate([_cores(g) for g in others]) if others else np.zeros((0, 3))
+        if _inside_hull(_cores(geom), cloud):
+            kept.remove(geom)
+    return kept
+
+
+def floor_colliders(robot: Robot, geoms: list[dict]) -> list[str]:
+    """Names of the colliders a floating base stands on at home: within `FOOT_BAND` of the
+    lowest point, less the shadowed ones."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(scratch_xml(robot, geoms, set()))
+    data = mujoco.MjData(model)
+    names = [j for j, _, _ in sampled_joints(robot)]
+    adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
+    data.qpos[adr] = _home(robot)
+    mujoco.mj_kinematics(model, data)
+    low = {}
+    for geom in geoms:
+        gid = model.geom(geom["name"]).id
+        body = model.geom_bodyid[gid]
+        vertices = None
+        if geom["kind"] == "piece":
+            local = piece_vertices(robot, geom)
+            vertices = local @ data.xmat[body].reshape(3, 3).T + data.xpos[body]
+        low[geom["name"]] = _lowest(
+            geom, data.geom_xpos[gid], data.geom_xmat[gid].reshape(3, 3), vertices
+        )
+    if not low:
+        return []
+    bottom = min(low.values())
+    candidates = [g for g in geoms if low[g["name"]] <= bottom + FOOT_BAND]
+    return sorted(g["name"] for g in _prune_shadowed(candidates))
+
+
+# --- the plan ---------------------------------------------------------------------------
+
+
+def pair_slots(kinds: dict[str, str], a: str, b: str, swaps: dict | None = None) -> int:
+    """MJX contact slots of one pair of colliders (`MJX_CONTACTS`); `floor` is the plane, and
+    a cylinder in `swaps` with this partner is its stand-in box."""
+    swaps = swaps or {}
+    types = [
+        "plane" if n == FLOOR else "box" if other in swaps.get(n, ()) else mujoco_type(kinds[n])
+        for n, other in ((a, b), (b, a))
+    ]
+    return MJX_CONTACTS[tuple(sorted(types, key=TYPE_ORDER.index))]  # type: ignore[index]
+
+
+def constraint_rows(robot: Robot, contacts: int) -> int:
+    """An upper bound on constraint rows per world: every contact (condim 3, pyramidal), every
+    joint limit, every joint with friction loss, every mimic equality."""
+    limited = sum(1 for j in robot.movable_joints if j.lower is not None and j.type != "continuous")
+    friction = sum(1 for j in robot.movable_joints if j.friction)
+    mimics = sum(1 for j in robot.joints if j.mimic is not None)
+    return ROWS_PER_CONTACT * contacts + limited + friction + mimics
+
+
+def derive_gpu_scene(robot: Robot) -> Robot:
+    """`products.gpu_scene`: colliders, contact pairs, floor pairs and the contact budget.
+
+    Slots per world are capped (MJX's `max_contact_points`, the deepest kept) at the floor
+    pairs all at once (standing) plus twice the most slots self-contact needs at once in a
+    sampled configuration that only touches (`peak_slots`)."""
+    geoms = [g for link in robot.links for g in colliders(link)]
+    q = configurations(robot, robot.seed)
+    contacts = sampled_contacts(robot, geoms, q)
+    pairs = sorted([a, b] for a, b in set().union(*(c for _, c in contacts)))
+    floor = floor_colliders(robot, geoms) if robot.floating_joint is not None else []
+    kinds = {g["name"]: g["kind"] for g in geoms}
+    swaps = stand_ins(kinds, pairs)
+    for geom in geoms:
+        if geom["name"] in swaps:
+            geom["box_for"] = swaps[geom["name"]]
+        if geom["kind"] == "piece" and len(piece_vertices(robot, geom)) > MAX_HULL_VERTICES:
+            geom["maxhullvert"] = MAX_HULL_VERTICES
+    standing = sum(pair_slots(kinds, FLOOR, g) for g in floor)
+    every = standing + sum(pair_slots(kinds, a, b, swaps) for a, b in pairs)
+    peak = peak_slots(kinds, contacts, swaps)
+    budget = every if peak is None else min(every, standing + 2 * peak)
+    block = {
+        "colliders": geoms,
+        "pairs": pairs,
+        "floor_pairs": floor,
+        "pair_slots": every,
+        "touching_peak": peak,
+        "contact_slots": budget,
+        "nconmax": max(budget, 1),
+        "njmax": max(constraint_rows(robot, budget), 1),
+        "iterations": ITERATIONS,
+        "ls_iterations": LS_ITERATIONS,
+        "method": METHOD,
+        "seed": robot.seed,
+        "samples": len(q),
+    }
+    if budget > SLOT_TARGET:
+        block["note"] = (
+            f"the GPU scene needs {budget} contact slots per world, over the {SLOT_TARGET} "
+            "simkit aims for: the source's collision geometry touches in that many places"
+        )
+    seeds = {**robot.products.seeds, "gpu_scene": robot.seed}
+    return replace(robot, products=replace(robot.products, gpu_scene=block, seeds=seeds))
