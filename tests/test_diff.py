@@ -14,7 +14,7 @@ from click.testing import CliRunner
 
 from simkit.cli import main
 from simkit.diff import diff_kits
-from simkit.diff_text import to_markdown
+from simkit.diff.markdown import to_markdown
 from simkit.kitio.obj import read_mesh, to_obj
 from simkit.kitio.stl import from_stl, to_stl
 
@@ -204,9 +204,9 @@ def _variant(tmp_path: Path, folder: str, old: str, new: str):
 
 
 def test_tolerances_are_the_checks():
-    """One rule per quantity: diff_tol's constants are the checks' own tolerances."""
+    """One rule per quantity: diff.tolerance's constants are the checks' own tolerances."""
     from simkit.check import geometry, mujoco, urdf
-    from simkit.diff_tol import ANGLE_RAD, LENGTH_M, PARAM_SI
+    from simkit.diff.tolerance import ANGLE_RAD, LENGTH_M, PARAM_SI
 
     assert LENGTH_M == urdf.TOL == mujoco.PARAM_TOL == geometry.CONVEX_TOL
     assert ANGLE_RAD == urdf.TOL and PARAM_SI == mujoco.PARAM_TOL
@@ -214,7 +214,7 @@ def test_tolerances_are_the_checks():
 
 def test_round_off_below_the_tolerances_is_no_change():
     """Numbers within the tolerance of their quantity are equal; beyond it they are not."""
-    from simkit.diff_tol import close, leaf_changes, text_close
+    from simkit.diff.tolerance import close, leaf_changes, text_close
 
     assert close(0.28, 0.280000001, 1e-6) and not close(0.28, 0.281, 1e-6)
     assert close(float("nan"), float("nan"), 1e-6) and not close(1.0, float("nan"), 1e-6)

@@ -16,7 +16,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from simkit.diff_tol import PARAM_SI, REL, STEP_LENGTH_MM, text_close
+from simkit.diff.report import Change
+from simkit.diff.tolerance import PARAM_SI, REL, STEP_LENGTH_MM, text_close
 
 
 def step_stats(data: bytes) -> dict[str, dict] | None:
@@ -84,9 +85,8 @@ def _solid_changes(a: dict, b: dict) -> list[tuple]:
     return out
 
 
-def step_changes(old: dict[str, bytes], new: dict[str, bytes], change) -> list:
-    """`Change`s (the `change` class of diff.py) for every STEP file whose bytes differ by
-    more than round-off."""
+def step_changes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
+    """`Change`s for every STEP file whose bytes differ by more than round-off."""
     out = []
     for path in sorted(set(old) & set(new)):
         if not path.endswith(".step") or text_close(old[path], new[path], PARAM_SI):
@@ -96,10 +96,10 @@ def step_changes(old: dict[str, bytes], new: dict[str, bytes], change) -> list:
             state = ["readable" if s is not None else "unreadable" for s in (a, b)]
             if a is None and b is None:
                 state = ["unreadable", "unreadable, other bytes"]
-            out.append(change("step", path, "modified", "file", *state))
+            out.append(Change("step", path, "modified", "file", *state))
             continue
-        out += [change("step", name, "removed") for name in a if name not in b]
-        out += [change("step", name, "added") for name in b if name not in a]
+        out += [Change("step", name, "removed") for name in a if name not in b]
+        out += [Change("step", name, "added") for name in b if name not in a]
         for name in (n for n in b if n in a):
-            out += [change("step", name, "modified", *c) for c in _solid_changes(a[name], b[name])]
+            out += [Change("step", name, "modified", *c) for c in _solid_changes(a[name], b[name])]
     return out

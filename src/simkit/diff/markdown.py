@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 import math
 
-from simkit.diff import Change, Report
+from simkit.diff.report import Change, Report
 from simkit.kitio.fmt import num
 
 ANGLE_FIELDS = {"lower", "upper", "max_velocity", "origin_rpy", "springref", "rotation"}
