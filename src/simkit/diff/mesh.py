@@ -1,22 +1,45 @@
-"""`simkit diff` for meshes: each STL compared as a placed piece in its link frame.
+"""`simkit diff` for meshes: each STL or OBJ compared as a placed piece in its link frame.
 
 A kit's meshes sit at the identity in their link frame (the URDF's <origin> is zero), so the
-vertices are link-frame positions. A piece is reported when it moved (volume centroid), turned
-(rigid fit of the vertices, when both files have the same triangles), changed shape (what the
-rigid fit leaves, the volume, the bounding box), each against diff_tol's length rule. A new
-triangulation of the same solid is not a change. GLB and USD files carry the same meshes as
-the STLs (the checks compare them), so their mesh arrays are compared through the STLs.
+vertices are link-frame positions. Each change is classed before it is described (issue 34):
+
+- rigid: one rigid motion carries the old surface onto the new within the length rule; the
+  piece moved (its volume centroid) and turned (the motion's angle);
+- scaled: one similarity does; the scale factor, and the volume and bounding box it changes;
+- changed shape: no motion does, and none is fitted: the largest distance between the old and
+  new surfaces (symmetric Hausdorff, sampled: `surface`), the volume, the bounding box, and
+  the region that changed (the bounding box of the points off the other surface).
+
+A fit is only a candidate (through the corners when both files have as many triangles, about
+the area centroids, along the principal axes), kept when the surfaces verify it. A new
+triangulation of the same surface is not a change.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterator
 from typing import NamedTuple
 
 import numpy as np
 
-from simkit.diff.tolerance import LENGTH_M, REL
+from simkit.diff.report import Change
+from simkit.diff.surface import (
+    Gap,
+    Mesh,
+    Similarity,
+    gap,
+    principal_axes,
+    similarity,
+    surface_centroid,
+    within,
+)
+from simkit.diff.tolerance import ANGLE_RAD, LENGTH_M, REL
 from simkit.errors import SimkitError
 from simkit.kitio.obj import read_mesh
+
+#: proper rotations that match two sets of principal axes whose signs are arbitrary
+AXIS_SIGNS = ((1, 1, 1), (1, -1, -1), (-1, 1, -1), (-1, -1, 1))
 
 
 class Piece(NamedTuple):
@@ -29,6 +52,8 @@ class Piece(NamedTuple):
     centroid: np.ndarray
     low: np.ndarray
     high: np.ndarray
+    #: the surface, for distances to it
+    mesh: Mesh
 
 
 def piece(path: str, data: bytes) -> Piece:
@@ -43,7 +68,7 @@ def piece(path: str, data: bytes) -> Piece:
     faces = np.asarray(mesh.faces)
     if not len(faces) or not np.all(np.isfinite(v)):
         zero = np.zeros(3)
-        return Piece(v, faces, 0.0, 0.0, zero, zero, zero)
+        return Piece(v, faces, 0.0, 0.0, zero, zero, zero, Mesh(v, faces))
     tri = v[faces]
     cross = np.cross(tri[:, 1], tri[:, 2])
     six_vol = np.einsum("ij,ij->i", tri[:, 0], cross)
@@ -56,49 +81,117 @@ def piece(path: str, data: bytes) -> Piece:
         centroid = (areas[:, None] * tri.mean(axis=1)).sum(axis=0) / area
     else:
         centroid = v.mean(axis=0)
-    return Piece(v, faces, volume, area, centroid, v.min(axis=0), v.max(axis=0))
+    low, high = v.min(axis=0), v.max(axis=0)
+    return Piece(v, faces, volume, area, centroid, low, high, Mesh(v, faces))
 
 
-def rigid_fit(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    """(rotation angle rad, largest vertex distance left) of the best rigid motion a -> b."""
-    ca, cb = a.mean(axis=0), b.mean(axis=0)
-    u, _s, vt = np.linalg.svd((a - ca).T @ (b - cb))
-    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
-    rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
-    left = float(np.linalg.norm((a - ca) @ rot.T + cb - b, axis=1).max())
-    angle = float(np.arccos(np.clip((np.trace(rot) - 1) / 2, -1.0, 1.0)))
-    return angle, left
+def _refined(fit: Similarity, a: Piece, b: Piece) -> Similarity:
+    """`fit` redone through each moved vertex of `a` and its nearest vertex of `b`: a fit
+    from moments is good to float32 round-off only, the pairs make it exact where the two
+    meshes share their vertices (scipy, lazily)."""
+    from scipy.spatial import cKDTree
+
+    _gaps, nearest = cKDTree(b.vertices).query(fit.apply(a.vertices))
+    return similarity(a.vertices, b.vertices[nearest], scaled=fit.scale != 1.0)
 
 
-def mesh_changes(path: str, old: bytes, new: bytes) -> list[tuple]:
-    """(field, old, new, unit) for every change of one mesh beyond the length rule."""
+def _candidates(a: Piece, b: Piece) -> Iterator[Similarity]:
+    """Similarities worth verifying, cheapest first; rigid ones before scaled ones."""
+    if len(a.faces) == len(b.faces):
+        ca, cb = a.vertices[a.faces].reshape(-1, 3), b.vertices[b.faces].reshape(-1, 3)
+        yield similarity(ca, cb, scaled=False)
+        yield similarity(ca, cb, scaled=True)
+    (area_a, centre_a), (area_b, centre_b) = surface_centroid(a.mesh), surface_centroid(b.mesh)
+    scales = [1.0] + ([math.sqrt(area_b / area_a)] if area_a > 0 and area_b > 0 else [])
+    axes_a, axes_b = principal_axes(a.mesh), principal_axes(b.mesh)
+    turns = [np.eye(3)] + [axes_b @ np.diag(s) @ axes_a.T for s in AXIS_SIGNS]
+    for scale in scales:
+        for rot in turns:
+            if np.linalg.det(rot) > 0:
+                fit = Similarity(scale, rot, centre_b - scale * rot @ centre_a)
+                yield fit
+                yield _refined(fit, a, b)
+
+
+def motion(a: Piece, b: Piece) -> Similarity | None:
+    """The first candidate similarity whose image of `a` lies on `b` within the length
+    rule, both ways; None when no similarity carries one surface onto the other."""
+    for fit in _candidates(a, b):
+        if within(Mesh(fit.apply(a.vertices), a.faces), b.mesh, LENGTH_M):
+            return fit
+    return None
+
+
+def _radius(p: Piece) -> float:
+    """The piece's extent about its centroid (m): an angle or a scale times it is a length."""
+    return float(np.linalg.norm(p.vertices - p.centroid, axis=1).max())
+
+
+def _volume_row(a: Piece, b: Piece) -> list[tuple]:
+    tol = LENGTH_M * max(a.area, b.area)
+    if abs(b.volume - a.volume) > tol + REL * abs(a.volume):
+        return [("volume", a.volume, b.volume, "m^3", tol)]
+    return []
+
+
+def _bbox_row(a: Piece, b: Piece) -> list[tuple]:
+    old, new = [*a.low, *a.high], [*b.low, *b.high]
+    if np.abs(np.subtract(new, old)).max() > LENGTH_M:
+        return [("bbox", [float(v) for v in old], [float(v) for v in new], "m", LENGTH_M)]
+    return []
+
+
+def _moved(fit: Similarity, a: Piece, b: Piece) -> list[tuple]:
+    """Rows of a rigid or scaled piece: displacement, rotation, scale (and what scaling
+    changes: volume, bounding box)."""
+    out = []
+    radius = max(_radius(a), LENGTH_M)
+    if float(np.linalg.norm(b.centroid - a.centroid)) > LENGTH_M:
+        out.append(("displacement", a.centroid.tolist(), b.centroid.tolist(), "m", LENGTH_M))
+    angle = float(np.arccos(np.clip((np.trace(fit.rotation) - 1) / 2, -1.0, 1.0)))
+    if angle * radius > LENGTH_M:
+        out.append(("rotation", 0.0, angle, "rad", ANGLE_RAD))
+    if abs(fit.scale - 1) * radius > LENGTH_M:
+        out.append(("scale", 1.0, fit.scale, "", LENGTH_M / radius))
+        out += _volume_row(a, b) + _bbox_row(a, b)
+    return out
+
+
+def _reshaped(found: Gap, a: Piece, b: Piece) -> list[tuple]:
+    """Rows of a changed shape: how far apart the surfaces are, and where; volume, box."""
+    out = [("shape", None, found.distance, "m", LENGTH_M)]
+    out += _volume_row(a, b) + _bbox_row(a, b)
+    if found.region is not None:
+        low, high = found.region
+        out.append(("region", None, [*map(float, low), *map(float, high)], "m", LENGTH_M))
+    if len(a.faces) != len(b.faces):
+        out.append(("triangles", len(a.faces), len(b.faces), "", 0.0))
+    return out
+
+
+def mesh_changes(path: str, old: bytes, new: bytes) -> list[Change]:
+    """Every change of one mesh beyond the length rule, classed rigid, scaled or changed
+    shape; nothing for the same surface, however triangulated."""
     a, b = piece(path, old), piece(path, new)
     finite = [bool(np.all(np.isfinite(p.vertices))) for p in (a, b)]
     if not all(finite):  # a hostile or damaged file: say so, compare nothing
         state = ["finite" if f else "non-finite" for f in finite]
-        return [("vertices", *state, "")] if finite[0] or old != new else []
-    out: list[tuple] = []
-    # the same triangles in the same order (an edited or moved piece): compare corner by corner
-    corners = len(a.faces) == len(b.faces) and len(a.faces) > 0
-    if corners:
-        ca, cb = a.vertices[a.faces].reshape(-1, 3), b.vertices[b.faces].reshape(-1, 3)
+        rows = [("vertices", *state, "", 0.0)] if finite[0] or old != new else []
+    elif not (len(a.faces) and len(b.faces)):
+        rows = [("triangles", len(a.faces), len(b.faces), "", 0.0)] if old != new else []
+    else:
+        rows = _rows(a, b)
+    return [Change("mesh", path, "modified", *row) for row in rows]
+
+
+def _rows(a: Piece, b: Piece) -> list[tuple]:
+    same_corners = len(a.faces) == len(b.faces)
+    if same_corners:
+        ca, cb = a.vertices[a.faces], b.vertices[b.faces]
         if float(np.abs(ca - cb).max()) <= LENGTH_M:
             return []
-    moved = float(np.linalg.norm(b.centroid - a.centroid))
-    if moved > LENGTH_M:
-        out.append(("displacement", a.centroid.tolist(), b.centroid.tolist(), "m"))
-    if corners:
-        angle, left = rigid_fit(ca, cb)
-        radius = float(np.linalg.norm(ca - ca.mean(axis=0), axis=1).max())
-        if angle * radius > LENGTH_M:
-            out.append(("rotation", 0.0, angle, "rad"))
-        if left > LENGTH_M:
-            out.append(("shape", 0.0, left, "m"))
-    if abs(b.volume - a.volume) > LENGTH_M * max(a.area, b.area) + REL * abs(a.volume):
-        out.append(("volume", a.volume, b.volume, "m^3"))
-    size_a, size_b = (a.high - a.low).tolist(), (b.high - b.low).tolist()
-    if np.abs(np.subtract(size_b, size_a)).max() > LENGTH_M:
-        out.append(("bbox", size_a, size_b, "m"))
-    if out and len(a.faces) != len(b.faces):
-        out.append(("triangles", len(a.faces), len(b.faces), ""))
-    return out
+    found = gap(a.mesh, b.mesh, LENGTH_M)
+    if found.distance <= LENGTH_M:
+        return []
+    fit = motion(a, b)
+    return _moved(fit, a, b) if fit is not None else _reshaped(found, a, b)

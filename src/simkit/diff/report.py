@@ -11,11 +11,15 @@ import json
 import math
 from dataclasses import asdict, dataclass, field
 
+from simkit.diff.tolerance import PARAM_SI, quantize
+
 
 @dataclass(frozen=True)
 class Change:
     """One semantic change: `kind` is joint, link, mesh, collision, step or robot_json; `change`
-    is modified, added or removed."""
+    is modified, added or removed. `old` and `new` are kept at `tolerance` (the absolute
+    tolerance of the quantity, in `unit`; 0 for counts and words): every number is rounded to
+    it and a number below it is 0, so no output can print round-off as a change."""
 
     kind: str
     name: str
@@ -24,6 +28,11 @@ class Change:
     old: object = None
     new: object = None
     unit: str = ""
+    tolerance: float = PARAM_SI
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "old", quantize(self.old, self.tolerance))
+        object.__setattr__(self, "new", quantize(self.new, self.tolerance))
 
 
 @dataclass

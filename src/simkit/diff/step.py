@@ -1,6 +1,8 @@
 """`simkit diff` for `step/NAME.step`: a changed STEP reported as per-link volume and
 bounding-box deltas (solids re-read with Open CASCADE, in the assembly frame, mm), each
-against diff_tol's length rule (mm) and, for volumes, that length times the solids' area.
+against the length rule in mm (`tolerance.STEP_LENGTH_MM`) and, for volumes, that length
+times the solids' area; every number shown at that tolerance. Only measured quantities are
+reported: the link's shape and motion are described by its mesh rows.
 
 Imported only when a STEP file's bytes differ, and Open CASCADE is loaded only when they
 differ by more than round-off of their numbers. A file Open CASCADE cannot read is reported
@@ -73,15 +75,15 @@ def _area(shape) -> float:
 
 
 def _solid_changes(a: dict, b: dict) -> list[tuple]:
-    """(field, old, new, unit) for one link's solids."""
+    """(field, old, new, unit, tolerance) for one link's solids: what was measured, never a
+    motion (a changed bounding box says where the solid reaches, not that it moved)."""
     out = []
-    tol = STEP_LENGTH_MM * max(a["area"], b["area"]) + REL * abs(a["volume"])
-    if abs(b["volume"] - a["volume"]) > tol:
-        out.append(("volume", round(a["volume"], 3), round(b["volume"], 3), "mm^3"))
+    tol = STEP_LENGTH_MM * max(a["area"], b["area"])
+    if abs(b["volume"] - a["volume"]) > tol + REL * abs(a["volume"]):
+        out.append(("volume", a["volume"], b["volume"], "mm^3", tol))
     moved = max((abs(x - y) for x, y in zip(a["bbox"], b["bbox"], strict=True)), default=0.0)
     if len(a["bbox"]) != len(b["bbox"]) or moved > STEP_LENGTH_MM:
-        boxes = [[round(v, 4) for v in box["bbox"]] for box in (a, b)]
-        out.append(("bbox", *boxes, "mm"))
+        out.append(("bbox", a["bbox"], b["bbox"], "mm", STEP_LENGTH_MM))
     return out
 
 

@@ -84,7 +84,7 @@ def _entities(
                 unit = "m"
             x, y = _flat(a.get(key)), _flat(b.get(key))
             if not same(x, y, tolerance(unit)):
-                out.append(Change(kind, name, "modified", key, x, y, unit))
+                out.append(Change(kind, name, "modified", key, x, y, unit, tolerance(unit)))
         out += _other_fields(kind, name, a, b, fields)
     return out
 
@@ -106,8 +106,7 @@ def _meshes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
     out = []
     for path in sorted(set(old) & set(new)):
         if path.endswith((".stl", ".obj")) and old[path] != new[path]:
-            changes = mesh_changes(path, old[path], new[path])
-            out += [Change("mesh", path, "modified", *c) for c in changes]
+            out += mesh_changes(path, old[path], new[path])
     return out
 
 

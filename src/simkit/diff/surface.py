@@ -1,0 +1,148 @@
+"""Two mesh surfaces compared without trusting their triangulations (issue 34).
+
+A rebuilt link solid may keep its triangle count while every triangle means something else,
+so nothing here pairs vertices by index unless a fit through them is then verified on the
+surfaces. `gap` is the symmetric Hausdorff distance between two surfaces, sampled: each
+mesh's vertices plus seeded, area-weighted points on its triangles, each point's exact
+distance to the other surface (trimesh's closest point on candidate triangles), and the
+bounding box of the points off the other surface (where the shape changed). `similarity`
+is the least-squares x -> s R x + t through paired points (Umeyama 1991, "Least-squares
+estimation of transformation parameters between two point patterns"); `principal_axes`
+and `surface_centroid` are exact per-triangle integrals, for candidate fits of meshes that
+share no triangulation. Link frame, metres.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import NamedTuple
+
+import numpy as np
+
+#: seeded sampling: the same two meshes always give the same distances (DESIGN.md)
+SEED = 34
+#: random surface points per mesh, beside its vertices (at most MAX_VERTICES of them)
+SAMPLES = 4000
+MAX_VERTICES = 4000
+
+
+class Mesh:
+    """Vertices (n, 3) m and triangles (m, 3) of one surface, with its proximity query built
+    once (trimesh, lazily) however many points are measured against it."""
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray) -> None:
+        self.vertices, self.faces = vertices, faces
+
+    @functools.cached_property
+    def query(self):
+        import trimesh
+
+        return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+
+class Similarity(NamedTuple):
+    """x -> scale * rotation @ x + shift (link frame, m)."""
+
+    scale: float
+    rotation: np.ndarray
+    shift: np.ndarray
+
+    def apply(self, points: np.ndarray) -> np.ndarray:
+        return self.scale * points @ self.rotation.T + self.shift
+
+
+class Gap(NamedTuple):
+    """The symmetric Hausdorff distance (m) between two surfaces, and the bounding box
+    (low, high, m) of the sample points farther than the tolerance from the other surface
+    (None where there are none)."""
+
+    distance: float
+    region: tuple[np.ndarray, np.ndarray] | None
+
+
+def samples(mesh: Mesh, seed: int = SEED) -> np.ndarray:
+    """The mesh's vertices (a seeded subset past MAX_VERTICES) and SAMPLES seeded points
+    spread over its triangles by area."""
+    rng = np.random.default_rng(seed)
+    v = mesh.vertices
+    if len(v) > MAX_VERTICES:
+        v = v[np.sort(rng.choice(len(v), MAX_VERTICES, replace=False))]
+    tri = mesh.vertices[mesh.faces]
+    areas = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    if not len(tri) or areas.sum() <= 0:
+        return v
+    pick = rng.choice(len(tri), SAMPLES, p=areas / areas.sum())
+    u, w = rng.random((2, SAMPLES))
+    flip = u + w > 1  # fold the far half of the unit square back into the triangle
+    u, w = np.where(flip, 1 - u, u), np.where(flip, 1 - w, w)
+    t = tri[pick]
+    points = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + w[:, None] * (t[:, 2] - t[:, 0])
+    return np.vstack([v, points])
+
+
+def distances(points: np.ndarray, mesh: Mesh) -> np.ndarray:
+    """Each point's exact distance (m) to the surface of `mesh` (trimesh, lazily)."""
+    import trimesh
+
+    if not len(points):
+        return np.zeros(0)
+    return np.asarray(trimesh.proximity.closest_point(mesh.query, points)[1], dtype=np.float64)
+
+
+def gap(a: Mesh, b: Mesh, tol: float) -> Gap:
+    """How far apart the surfaces of `a` and `b` are, and where, sampled both ways."""
+    pa, pb = samples(a), samples(b)
+    da, db = distances(pa, b), distances(pb, a)
+    off = np.vstack([pa[da > tol], pb[db > tol]])
+    region = (off.min(axis=0), off.max(axis=0)) if len(off) else None
+    return Gap(float(max(da.max(initial=0.0), db.max(initial=0.0))), region)
+
+
+def within(a: Mesh, b: Mesh, tol: float) -> bool:
+    """Do the surfaces of `a` and `b` lie within `tol` of each other? The vertices first
+    (a cheap refusal of a wrong fit), then every sample both ways."""
+    if float(distances(a.vertices[:: max(1, len(a.vertices) // 64)], b).max()) > tol:
+        return False
+    return gap(a, b, tol).distance <= tol
+
+
+def similarity(a: np.ndarray, b: np.ndarray, scaled: bool) -> Similarity:
+    """The least-squares similarity (rigid when not `scaled`) carrying points a onto b."""
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    u, s, vt = np.linalg.svd((b - cb).T @ (a - ca))
+    d = np.ones(3)
+    d[2] = np.sign(np.linalg.det(u @ vt)) or 1.0
+    rot = u @ np.diag(d) @ vt
+    spread = float(((a - ca) ** 2).sum())
+    scale = float((s * d).sum() / spread) if scaled and spread > 0 else 1.0
+    return Similarity(scale, rot, cb - scale * rot @ ca)
+
+
+def _moments(mesh: Mesh) -> tuple[float, np.ndarray, np.ndarray]:
+    """(area m^2, first moment m^3, second moment m^4) of the surface, exact per triangle."""
+    tri = mesh.vertices[mesh.faces]
+    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1) / 2
+    total = tri.sum(axis=1)
+    first = (area[:, None] * total / 3).sum(axis=0)
+    # the integral of x x^T over a triangle: A/12 (sum_i v_i v_i^T + s s^T), s = sum_i v_i
+    second = np.einsum("t,tij->ij", area / 12, np.einsum("tki,tkj->tij", tri, tri))
+    second += np.einsum("t,ti,tj->ij", area / 12, total, total)
+    return float(area.sum()), first, second
+
+
+def surface_centroid(mesh: Mesh) -> tuple[float, np.ndarray]:
+    """(area m^2, area centroid m) of the surface."""
+    area, first, _ = _moments(mesh)
+    return area, (first / area if area > 0 else mesh.vertices.mean(axis=0))
+
+
+def principal_axes(mesh: Mesh) -> np.ndarray:
+    """The columns are the principal axes of the surface's second moment about its area
+    centroid, largest moment first (sign and order of equal moments are arbitrary)."""
+    area, first, second = _moments(mesh)
+    if area <= 0:
+        return np.eye(3)
+    centroid = first / area
+    central = second - area * np.outer(centroid, centroid)
+    _values, vectors = np.linalg.eigh(central)
+    return vectors[:, ::-1]
