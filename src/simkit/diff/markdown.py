@@ -51,12 +51,18 @@ def _numbers(values: list, tol: float) -> str:
     return ", ".join(number(quantize(float(v), tol)) for v in values)
 
 
+def degrees_text(value: float, tol: float) -> str:
+    """An angle kept at `tol` rad, in degrees at the power of ten just above `tol` in
+    degrees (1e-6 rad -> 1e-4 deg): finer digits would show the radians' rounding."""
+    shown = 10.0 ** math.ceil(math.log10(math.degrees(tol)))
+    return number(quantize(math.degrees(value), shown))
+
+
 def _degrees(value: float, tol: float, unit: str) -> str:
-    """(D deg), an angle in radians also in degrees at the same tolerance in degrees."""
-    degrees = math.degrees(value)
-    if not math.isfinite(degrees):
+    """(D deg), an angle in radians also in degrees."""
+    if not math.isfinite(math.degrees(value)):
         return ""
-    return f" ({number(quantize(degrees, math.degrees(tol)))} deg{unit[3:]})"
+    return f" ({degrees_text(value, tol)} deg{unit[3:]})"
 
 
 def value_text(value, unit: str, field_name: str, tol: float = PARAM_SI) -> str:
@@ -88,7 +94,7 @@ def _described(change: Change) -> str | None:
         norm = math.sqrt(sum(v * v for v in step))
         return f"moved ({_numbers(step, tol)}) m, {number(quantize(norm, tol))} m"
     if change.field == "rotation" and _is_num(b):
-        return f"turned {number(quantize(math.degrees(b), math.degrees(tol)))} deg"
+        return f"turned {degrees_text(b, tol)} deg"
     if change.field == "scale" and _is_num(b):
         return f"scaled by {number(b)}"
     if change.field == "shape" and _is_num(b):

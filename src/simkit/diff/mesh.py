@@ -30,6 +30,7 @@ from simkit.diff.surface import (
     Similarity,
     gap,
     principal_axes,
+    same_vertices,
     similarity,
     surface_centroid,
     within,
@@ -89,9 +90,7 @@ def _refined(fit: Similarity, a: Piece, b: Piece) -> Similarity:
     """`fit` redone through each moved vertex of `a` and its nearest vertex of `b`: a fit
     from moments is good to float32 round-off only, the pairs make it exact where the two
     meshes share their vertices (scipy, lazily)."""
-    from scipy.spatial import cKDTree
-
-    _gaps, nearest = cKDTree(b.vertices).query(fit.apply(a.vertices))
+    _gaps, nearest = b.mesh.tree.query(fit.apply(a.vertices))
     return similarity(a.vertices, b.vertices[nearest], scaled=fit.scale != 1.0)
 
 
@@ -114,9 +113,15 @@ def _candidates(a: Piece, b: Piece) -> Iterator[Similarity]:
 
 
 def motion(a: Piece, b: Piece) -> Similarity | None:
-    """The first candidate similarity whose image of `a` lies on `b` within the length
-    rule, both ways; None when no similarity carries one surface onto the other."""
+    """The first candidate similarity whose image of `a` is `b` within the length rule
+    (`surface.within`); None when no similarity carries one surface onto the other."""
+    tried: list[np.ndarray] = []
+    box = np.array([a.low, a.high])
     for fit in _candidates(a, b):
+        corners = fit.apply(box)  # a fit that moves the box as a tried one did is that one
+        if any(np.abs(corners - seen).max() <= LENGTH_M for seen in tried):
+            continue
+        tried.append(corners)
         if within(Mesh(fit.apply(a.vertices), a.faces), b.mesh, LENGTH_M):
             return fit
     return None
@@ -190,8 +195,9 @@ def _rows(a: Piece, b: Piece) -> list[tuple]:
         ca, cb = a.vertices[a.faces], b.vertices[b.faces]
         if float(np.abs(ca - cb).max()) <= LENGTH_M:
             return []
-    found = gap(a.mesh, b.mesh, LENGTH_M)
-    if found.distance <= LENGTH_M:
+    if same_vertices(a.mesh, b.mesh, LENGTH_M):
         return []
-    fit = motion(a, b)
-    return _moved(fit, a, b) if fit is not None else _reshaped(found, a, b)
+    fit = motion(a, b)  # the first candidate is (nearly) the identity: no change is caught
+    if fit is not None:
+        return _moved(fit, a, b)
+    return _reshaped(gap(a.mesh, b.mesh, LENGTH_M), a, b)

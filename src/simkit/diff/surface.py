@@ -39,6 +39,12 @@ class Mesh:
 
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
 
+    @functools.cached_property
+    def tree(self):
+        from scipy.spatial import cKDTree
+
+        return cKDTree(self.vertices)
+
 
 class Similarity(NamedTuple):
     """x -> scale * rotation @ x + shift (link frame, m)."""
@@ -98,9 +104,22 @@ def gap(a: Mesh, b: Mesh, tol: float) -> Gap:
     return Gap(float(max(da.max(initial=0.0), db.max(initial=0.0))), region)
 
 
+def same_vertices(a: Mesh, b: Mesh, tol: float) -> bool:
+    """Is every vertex of each mesh within `tol` of a vertex of the other? Then the two differ
+    at most in how the same points are joined into triangles (a quad split along its other
+    diagonal moves a curved surface by micrometres): a new triangulation, not a new shape."""
+    return all(
+        len(p.vertices) and float(q.tree.query(p.vertices)[0].max()) <= tol
+        for p, q in ((a, b), (b, a))
+    )
+
+
 def within(a: Mesh, b: Mesh, tol: float) -> bool:
-    """Do the surfaces of `a` and `b` lie within `tol` of each other? The vertices first
-    (a cheap refusal of a wrong fit), then every sample both ways."""
+    """Are `a` and `b` the same surface within `tol`: the same vertices (`same_vertices`), or
+    every sample of each within `tol` of the other's surface? The vertices of `a` are
+    measured first, a cheap refusal of a wrong fit."""
+    if same_vertices(a, b, tol):
+        return True
     if float(distances(a.vertices[:: max(1, len(a.vertices) // 64)], b).max()) > tol:
         return False
     return gap(a, b, tol).distance <= tol
