@@ -175,3 +175,16 @@ def test_no_printed_component_is_below_its_tolerance(reproducer, kit_factory, tm
     assert "| `link_1` | com | (0.15, 0, 0) m | (0.16, 0, 0) m | (0.01, 0, 0) m |" in to_markdown(
         diff_kits(planar, edited)
     )
+
+
+def test_the_docs_show_the_reproducer_as_the_diff_prints_it(reproducer, tmp_path):
+    """docs/diff.md's example table is the `--markdown` summary of the reproducer, row for
+    row (the file counts below it depend on where each spec was built from)."""
+    docs = (Path(__file__).resolve().parents[1] / "docs" / "diff.md").read_text()
+    shown = docs.split("<!-- reproducer summary")[1].split("<!-- end of reproducer summary")[0]
+    old, new = reproducer
+    summary = tmp_path / "summary.md"
+    CliRunner().invoke(main, ["diff", str(old), str(new), "--markdown", str(summary)])
+    printed = summary.read_text().splitlines()
+    rows = [line for line in shown.splitlines() if line.startswith("| ")]
+    assert rows == [line for line in printed if line.startswith("| ")]
