@@ -7,6 +7,7 @@ or copied and edited as a user would edit a kit's mesh (rotated, scaled in place
 
 from __future__ import annotations
 
+import html
 import json
 import math
 import re
@@ -23,6 +24,7 @@ from simkit.diff import Change, Report, diff_kits
 from simkit.diff.markdown import to_markdown
 from simkit.diff.tolerance import decimals
 from simkit.kitio.stl import from_stl, to_stl
+from simkit.review.diff_html import to_html
 
 SPECS = Path(__file__).resolve().parent / "specs"
 PLANAR = SPECS / "planar_2r.yaml"
@@ -137,6 +139,15 @@ def _markdown_offences(text: str, tolerances: dict[tuple, float]) -> list[str]:
     return out
 
 
+def _html_rows(page: str) -> str:
+    """The HTML report's change tables as Markdown rows (`| `name` | field | ... |`)."""
+    rows = []
+    for row in re.findall(r"<tr>((?:<td>.*?</td>)+)</tr>", page):
+        name, *rest = (html.unescape(c) for c in re.findall(r"<td>(.*?)</td>", row))
+        rows.append("| " + " | ".join([f"`{name}`", *rest]) + " |")
+    return "\n".join(rows)
+
+
 def _flat(value) -> list:
     return [x for v in value for x in _flat(v)] if isinstance(value, list) else [value]
 
@@ -153,8 +164,9 @@ def _json_offences(doc: dict) -> list[str]:
 
 
 def test_no_printed_component_is_below_its_tolerance(reproducer, kit_factory, tmp_path):
-    """Markdown and --json of the reproducer, and of a robot.json CoM edit with components of
-    3e-7 m and 4e-7 m (below the 1e-6 m length rule), print none finer than the rule."""
+    """Markdown, --json and the HTML table of the reproducer, and of a robot.json CoM edit
+    with components of 3e-7 m and 4e-7 m (below the 1e-6 m length rule), print none finer
+    than the rule."""
     planar = kit_factory(str(PLANAR)).kit_dir
     edited = tmp_path / "com"
     shutil.copytree(planar, edited)
@@ -170,6 +182,9 @@ def test_no_printed_component_is_below_its_tolerance(reproducer, kit_factory, tm
         assert _markdown_offences(result.output, tolerances) == []
         result = CliRunner().invoke(main, ["diff", "--json", str(old), str(new)])
         assert _json_offences(json.loads(result.output)) == []
+        page = _html_rows(to_html(report, []))
+        assert page.count("\n") + 1 == len(report.changes)
+        assert _markdown_offences(page, tolerances) == []
         scanned += result.output.count('"tolerance"')
     assert scanned >= 6
     assert "| `link_1` | com | (0.15, 0, 0) m | (0.16, 0, 0) m | (0.01, 0, 0) m |" in to_markdown(

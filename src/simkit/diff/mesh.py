@@ -154,8 +154,8 @@ def _moved(fit: Similarity, a: Piece, b: Piece) -> list[tuple]:
     if float(np.linalg.norm(b.centroid - a.centroid)) > LENGTH_M:
         out.append(("displacement", a.centroid.tolist(), b.centroid.tolist(), "m", LENGTH_M))
     angle = float(np.arccos(np.clip((np.trace(fit.rotation) - 1) / 2, -1.0, 1.0)))
-    if angle * radius > LENGTH_M:
-        out.append(("rotation", 0.0, angle, "rad", ANGLE_RAD))
+    if angle * radius > LENGTH_M:  # shown at the angle that moves the piece by the rule
+        out.append(("rotation", 0.0, angle, "rad", min(ANGLE_RAD, LENGTH_M / radius)))
     if abs(fit.scale - 1) * radius > LENGTH_M:
         out.append(("scale", 1.0, fit.scale, "", LENGTH_M / radius))
         out += _volume_row(a, b) + _bbox_row(a, b)
@@ -190,14 +190,15 @@ def mesh_changes(path: str, old: bytes, new: bytes) -> list[Change]:
 
 
 def _rows(a: Piece, b: Piece) -> list[tuple]:
-    same_corners = len(a.faces) == len(b.faces)
-    if same_corners:
+    """(field, old, new, unit, tolerance) rows of two finite, non-empty pieces."""
+    if len(a.faces) == len(b.faces):
         ca, cb = a.vertices[a.faces], b.vertices[b.faces]
         if float(np.abs(ca - cb).max()) <= LENGTH_M:
             return []
     if same_vertices(a.mesh, b.mesh, LENGTH_M):
         return []
-    fit = motion(a, b)  # the first candidate is (nearly) the identity: no change is caught
+    fit = motion(a, b)  # an unchanged surface verifies the centroid fit with no turn: no rows
     if fit is not None:
         return _moved(fit, a, b)
-    return _reshaped(gap(a.mesh, b.mesh, LENGTH_M), a, b)
+    found = gap(a.mesh, b.mesh, LENGTH_M)
+    return _reshaped(found, a, b) if found.distance > LENGTH_M else []
