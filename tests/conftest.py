@@ -46,6 +46,26 @@ def rosie_1000_published(tmp_path_factory) -> tuple[Path, dict]:
     return out, publish(out, ["rosie_1000"], cache=Cache.disabled())
 
 
+@pytest.fixture(scope="session")
+def spec_variant(tmp_path_factory):
+    """`spec_variant(spec, old, new)` -> BuildResult of a copy of the spec file `spec` with the
+    text `old` replaced by `new` once (same file name, own folder and --out), built once per
+    session: a kit that differs from its seed by one edit, for `simkit diff`."""
+    cache: dict[tuple, BuildResult] = {}
+
+    def get(spec: Path, old: str, new: str) -> BuildResult:
+        key = (str(spec), old, new)
+        if key not in cache:
+            text = spec.read_text()
+            assert old in text, (spec, old)
+            folder = tmp_path_factory.mktemp("variant")
+            (folder / spec.name).write_text(text.replace(old, new, 1))
+            cache[key] = build(str(folder / spec.name), folder / "out")
+        return cache[key]
+
+    return get
+
+
 #: The five seed robots (robots/*.yaml).
 SEED_ROBOTS = ("asimov", "ecn_2r", "rosie_1000", "rosie_1400", "rosie_600")
 
@@ -65,7 +85,7 @@ def pytest_addoption(parser):
 
 
 #: Fixtures that build (and check) real kits: a test using any of them is in the slow tier.
-KIT_FIXTURES = {"kit_factory", "rosie_1000", "rosie_1000_published", "seed_kits"}
+KIT_FIXTURES = {"kit_factory", "rosie_1000", "rosie_1000_published", "seed_kits", "spec_variant"}
 
 
 def pytest_collection_modifyitems(config, items):

@@ -14,7 +14,7 @@ from click.testing import CliRunner
 
 from simkit.cli import main
 from simkit.diff import diff_kits
-from simkit.diff_text import to_markdown
+from simkit.diff.markdown import to_markdown
 from simkit.kitio.obj import read_mesh, to_obj
 from simkit.kitio.stl import from_stl, to_stl
 
@@ -66,7 +66,7 @@ def test_one_limit_and_one_mass_change_report_exactly_those_two(rosie_1000, copy
     assert (link.old, link.new, link.unit) == (10.4, 11.0, "kg")
     assert report.changed == ["robot.json"] and not report.added and not report.removed
     text = to_markdown(report)
-    assert "| `J2` | upper | 2.35619 rad (135 deg) | 2 rad (114.59 deg) | -0.356194 rad" in text
+    assert "| `J2` | upper | 2.356194 rad (135 deg) | 2 rad (114.5916 deg) | -0.356194 rad" in text
     assert "| `link_2` | mass | 10.4 kg | 11 kg | +0.6 kg, 5.77 % |" in text
     result = CliRunner().invoke(main, ["diff", "--json", str(rosie_1000.kit_dir), str(copy)])
     assert result.exit_code == 1
@@ -113,7 +113,7 @@ def test_each_kind_of_change(rosie_1000, copy):
         ("robot_json", "payload", "modified", "rated"),
     }
     extra = keys - {k for k in keys if k[0] != "mesh" and k[0] != "collision"}
-    scaled = ("volume", "bbox", "displacement", "shape")  # scaled about the link origin
+    scaled = ("scale", "volume", "bbox", "displacement")  # scaled about the link origin
     assert extra <= {("mesh", "meshes/visual/link_4.stl", "modified", f) for f in scaled} | {
         ("collision", "link_1", "modified", "pieces")
     }
@@ -121,7 +121,9 @@ def test_each_kind_of_change(rosie_1000, copy):
     volume = by_key[("mesh", "meshes/visual/link_4.stl", "modified", "volume")]
     assert volume.new / volume.old == pytest.approx(1.331, rel=1e-5) and volume.unit == "m^3"
     box = by_key[("mesh", "meshes/visual/link_4.stl", "modified", "bbox")]
-    assert np.allclose(np.array(box.new) / np.array(box.old), 1.1, rtol=1e-5)
+    assert np.allclose(box.new, np.multiply(box.old, 1.1), atol=2e-6)  # bounds, at 1e-6 m
+    scale = by_key[("mesh", "meshes/visual/link_4.stl", "modified", "scale")]
+    assert scale.new == pytest.approx(1.1, abs=1e-5)
     pieces_change = by_key[("collision", "link_1", "modified", "pieces")]
     assert pieces_change.new == pieces_change.old + 1
     assert report.added == [f"meshes/collision/link_1_{len(pieces):02d}.obj"]
@@ -191,22 +193,10 @@ ECN_SPEC = Path(__file__).resolve().parents[1] / "robots" / "ecn_2r.yaml"
 ARM_BOX = "size: [0.28, 0.08, 0.05], xyz: [0.14, 0, 0.175]"
 
 
-def _variant(tmp_path: Path, folder: str, old: str, new: str):
-    """ecn_2r built from a copy of its spec with one edit (same file name, own --out)."""
-    from simkit.pipeline import build
-
-    text = ECN_SPEC.read_text()
-    assert old in text
-    spec = tmp_path / folder / "ecn_2r.yaml"
-    spec.parent.mkdir()
-    spec.write_text(text.replace(old, new, 1))
-    return build(str(spec), tmp_path / folder / "out")
-
-
 def test_tolerances_are_the_checks():
-    """One rule per quantity: diff_tol's constants are the checks' own tolerances."""
+    """One rule per quantity: diff.tolerance's constants are the checks' own tolerances."""
     from simkit.check import geometry, mujoco, urdf
-    from simkit.diff_tol import ANGLE_RAD, LENGTH_M, PARAM_SI
+    from simkit.diff.tolerance import ANGLE_RAD, LENGTH_M, PARAM_SI
 
     assert LENGTH_M == urdf.TOL == mujoco.PARAM_TOL == geometry.CONVEX_TOL
     assert ANGLE_RAD == urdf.TOL and PARAM_SI == mujoco.PARAM_TOL
@@ -214,7 +204,7 @@ def test_tolerances_are_the_checks():
 
 def test_round_off_below_the_tolerances_is_no_change():
     """Numbers within the tolerance of their quantity are equal; beyond it they are not."""
-    from simkit.diff_tol import close, leaf_changes, text_close
+    from simkit.diff.tolerance import close, leaf_changes, text_close
 
     assert close(0.28, 0.280000001, 1e-6) and not close(0.28, 0.281, 1e-6)
     assert close(float("nan"), float("nan"), 1e-6) and not close(1.0, float("nan"), 1e-6)
@@ -226,13 +216,12 @@ def test_round_off_below_the_tolerances_is_no_change():
     assert not text_close(b"<link name='a'/>", b"<link name='b'/>")
 
 
-@pytest.mark.slow
-def test_a_length_changed_by_1e_9_m_prints_no_change(tmp_path):
+def test_a_length_changed_by_1e_9_m_prints_no_change(spec_variant):
     """The arm box 1e-9 m longer: files differ by round-off (and a new triangulation of the
-    same solid), the diff reports nothing and exits 0. Both built from a spec of one path,
+    same solid), the diff reports nothing and exits 0. Both built from a spec of one name,
     which the files' headers name."""
-    old = _variant(tmp_path, "base", ARM_BOX, ARM_BOX)
-    new = _variant(tmp_path, "longer", ARM_BOX, ARM_BOX.replace("0.28,", "0.280000001,"))
+    old = spec_variant(ECN_SPEC, ARM_BOX, ARM_BOX)
+    new = spec_variant(ECN_SPEC, ARM_BOX, ARM_BOX.replace("0.28,", "0.280000001,"))
     report = diff_kits(old.kit_dir, new.kit_dir)
     assert report.equal and not report.identical, report.changes
     assert report.changes == [] and report.changed == [] and report.round_off
@@ -243,10 +232,9 @@ def test_a_length_changed_by_1e_9_m_prints_no_change(tmp_path):
     assert "m^3" not in result.output and "| " not in result.output
 
 
-@pytest.mark.slow
-def test_a_primitive_moved_50_mm_is_reported_with_its_displacement(kit_factory, tmp_path):
+def test_a_primitive_moved_50_mm_is_reported_with_its_displacement(kit_factory, spec_variant):
     old = kit_factory("ecn_2r")
-    new = _variant(tmp_path, "moved", ARM_BOX, ARM_BOX.replace("0.14, 0,", "0.14, 0.05,"))
+    new = spec_variant(ECN_SPEC, ARM_BOX, ARM_BOX.replace("0.14, 0,", "0.14, 0.05,"))
     report = diff_kits(old.kit_dir, new.kit_dir)
     moved = [
         c

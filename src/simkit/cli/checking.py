@@ -84,7 +84,7 @@ def diff(old: Path, new: Path, as_json: bool, html_out: Path | None, md_out: Pat
     """Report what changed between two kits (folders or zips) beyond the checks' tolerances;
     exit 0 equal, 1 different."""
     from simkit.diff import diff_kits
-    from simkit.diff_text import to_markdown, to_short_markdown
+    from simkit.diff.markdown import to_markdown, to_short_markdown
 
     try:
         report = diff_kits(old, new)

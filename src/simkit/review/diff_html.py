@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from simkit.diff import Change, Report
-from simkit.diff_text import TITLES, cells, no_change, summary
+from simkit.diff.markdown import TITLES, cells, no_change, summary
 from simkit.errors import SimkitError
 from simkit.review.png import png_bytes, read_png
 from simkit.review.progress import Reporter
@@ -126,7 +126,7 @@ def _img(data: bytes | None, alt: str) -> str:
 
 
 def _changes_html(changes: Sequence[Change]) -> list[str]:
-    """One table per kind of change; every cell filled (`diff_text.cells`)."""
+    """One table per kind of change; every cell filled (`diff.markdown.cells`)."""
     out = []
     for kind, title in TITLES.items():
         items = [c for c in changes if c.kind == kind]

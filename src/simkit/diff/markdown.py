@@ -1,6 +1,8 @@
 """`simkit diff` as Markdown: the full report (stdout) and the short one for a GitHub job
 summary or pull request comment (`--markdown FILE`), and the cell texts the HTML report
-shares. Non-finite numbers read from a kit (NaN, inf) are printed as such, never raised.
+shares. One formatting rule (issue 34): every number at the tolerance of its quantity, a
+component below it 0, as in `--json` (`tolerance.quantize`). Non-finite numbers read from a
+kit (NaN, inf) are printed as such, never raised.
 """
 
 from __future__ import annotations
@@ -8,10 +10,13 @@ from __future__ import annotations
 import json
 import math
 
-from simkit.diff import Change, Report
+from simkit.diff.report import Change, Report
+from simkit.diff.tolerance import PARAM_SI, quantize
 from simkit.kitio.fmt import num
 
 ANGLE_FIELDS = {"lower", "upper", "max_velocity", "origin_rpy", "springref", "rotation"}
+#: fields that hold a bounding box (low x, y, z, high x, y, z)
+BOXES = {"bbox"}
 TITLES = {
     "joint": "Joints",
     "link": "Links",
@@ -26,21 +31,41 @@ MAX_LISTED = 9
 SHORT_ROWS = 40
 
 
-def number(value: float, digits: int = 6) -> str:
-    """`fmt.num`, with NaN and infinities written out instead of raised."""
+def number(value: float) -> str:
+    """`fmt.num`, with NaN and infinities written out instead of raised. Values come
+    quantized (`Change`), so the digits shown are the ones the tolerance resolves."""
     x = float(value)
     if math.isnan(x):
         return "NaN"
     if math.isinf(x):
         return "inf" if x > 0 else "-inf"
-    return num(x, digits)
+    return num(x)
 
 
 def _is_num(value: object) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def value_text(value, unit: str, field_name: str) -> str:
+def _numbers(values: list, tol: float) -> str:
+    """Comma-separated numbers, each at the tolerance `tol`."""
+    return ", ".join(number(quantize(float(v), tol)) for v in values)
+
+
+def degrees_text(value: float, tol: float) -> str:
+    """An angle kept at `tol` rad, in degrees at the power of ten just above `tol` in
+    degrees (1e-6 rad -> 1e-4 deg): finer digits would show the radians' rounding."""
+    shown = 10.0 ** math.ceil(math.log10(math.degrees(tol)))
+    return number(quantize(math.degrees(value), shown))
+
+
+def _degrees(value: float, tol: float, unit: str) -> str:
+    """(D deg), an angle in radians also in degrees."""
+    if not math.isfinite(math.degrees(value)):
+        return ""
+    return f" ({degrees_text(value, tol)} deg{unit[3:]})"
+
+
+def value_text(value, unit: str, field_name: str, tol: float = PARAM_SI) -> str:
     """One old or new value with its unit (radians also in degrees)."""
     if value is None:
         return "-"
@@ -49,10 +74,11 @@ def value_text(value, unit: str, field_name: str) -> str:
     if _is_num(value):
         text = f"{number(value)} {unit}".rstrip()
         if unit.startswith("rad") and field_name in ANGLE_FIELDS and math.isfinite(value):
-            degrees = math.degrees(value)
-            text += f" ({number(degrees, 5)} deg{unit[3:]})" if math.isfinite(degrees) else ""
+            text += _degrees(value, tol, unit)
         return text
     if isinstance(value, list) and all(_is_num(v) for v in value):
+        if field_name in BOXES and len(value) == 6:
+            return f"({_numbers(value[:3], tol)}) to ({_numbers(value[3:], tol)}) {unit}"
         shown = [number(v) for v in value[:MAX_LISTED]]
         more = f", ... {len(value) - MAX_LISTED} more" if len(value) > MAX_LISTED else ""
         return f"({', '.join(shown)}{more}) {unit}".rstrip()
@@ -60,30 +86,49 @@ def value_text(value, unit: str, field_name: str) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+def _described(change: Change) -> str | None:
+    """What a mesh's own fields say about it: moved, turned, scaled, changed shape, where."""
+    a, b, tol = change.old, change.new, change.tolerance
+    if change.field == "displacement" and isinstance(a, list) and isinstance(b, list):
+        step = [y - x for x, y in zip(a, b, strict=True)]
+        norm = math.sqrt(sum(v * v for v in step))
+        return f"moved ({_numbers(step, tol)}) m, {number(quantize(norm, tol))} m"
+    if change.field == "rotation" and _is_num(b):
+        return f"turned {degrees_text(b, tol)} deg"
+    if change.field == "scale" and _is_num(b):
+        return f"scaled by {number(b)}"
+    if change.field == "shape" and _is_num(b):
+        return f"changed shape: surfaces up to {number(b)} m apart"
+    if change.field == "region" and isinstance(b, list) and len(b) == 6:
+        return f"changed within ({_numbers(b[:3], tol)}) to ({_numbers(b[3:], tol)}) m"
+    if change.field in BOXES and isinstance(a, list) and isinstance(b, list) and len(a) == 6:
+        step = [y - x for x, y in zip(a, b, strict=True)]
+        unit = change.unit
+        return f"low ({_numbers(step[:3], tol)}) {unit}, high ({_numbers(step[3:], tol)}) {unit}"
+    return None
+
+
 def delta_text(change: Change) -> str:
-    """NEW - OLD with its unit (and in %), or what the field says about the change."""
-    a, b = change.old, change.new
+    """NEW - OLD with its unit (and in %), or what the field says about the change; every
+    number at the change's tolerance."""
+    a, b, tol = change.old, change.new, change.tolerance
     if change.change != "modified":
         return change.change
-    if change.field == "displacement" and isinstance(a, list) and isinstance(b, list):
-        d = [y - x for x, y in zip(a, b, strict=True)]
-        norm = math.sqrt(sum(v * v for v in d))
-        return f"moved ({', '.join(number(v) for v in d)}) m, {number(norm)} m"
-    if change.field == "rotation" and _is_num(b):
-        return f"turned {number(math.degrees(b), 5)} deg"
-    if change.field == "shape" and _is_num(b):
-        return f"vertices up to {number(b)} m off a rigid motion"
+    said = _described(change)
+    if said is not None:
+        return said
     if _is_num(a) and _is_num(b):
         step = b - a
         if not math.isfinite(step):
             return "changed"
-        rel = f", {number(100 * step / a, 3)} %" if a and math.isfinite(100 * step / a) else ""
-        return f"{'+' if step >= 0 else ''}{number(step)} {change.unit}".rstrip() + rel
+        rel = f", {num(100 * step / a, 3)} %" if a and math.isfinite(100 * step / a) else ""
+        shown = number(quantize(float(step), tol)) if tol > 0 else number(step)
+        return f"{'+' if step >= 0 else ''}{shown} {change.unit}".rstrip() + rel
     numeric = isinstance(a, list) and isinstance(b, list) and len(a) == len(b)
     if numeric and len(a) <= MAX_LISTED and all(_is_num(v) for v in a + b):
         steps = [y - x for x, y in zip(a, b, strict=True)]
         if all(math.isfinite(v) for v in steps):
-            return f"({', '.join(number(v) for v in steps)}) {change.unit}".rstrip()
+            return f"({_numbers(steps, tol)}) {change.unit}".rstrip()
     return "changed"
 
 
@@ -91,13 +136,13 @@ def cells(change: Change) -> list[str]:
     """name, field, old, new, change: every cell filled (added and removed rows too)."""
     if change.change != "modified":
         return [change.name, "-", "-", "-", change.change]
-    return [
-        change.name,
-        change.field or "-",
-        value_text(change.old, change.unit, change.field),
-        value_text(change.new, change.unit, change.field),
-        delta_text(change),
+    shown = [
+        value_text(value, change.unit, change.field, change.tolerance)
+        for value in (change.old, change.new)
     ]
+    if change.field in ("shape", "region"):  # a measure of the change, not an old or new value
+        shown = ["-", "-"]
+    return [change.name, change.field or "-", *shown, delta_text(change)]
 
 
 def summary(report: Report) -> str:

@@ -1,6 +1,8 @@
 """`simkit diff` for `step/NAME.step`: a changed STEP reported as per-link volume and
 bounding-box deltas (solids re-read with Open CASCADE, in the assembly frame, mm), each
-against diff_tol's length rule (mm) and, for volumes, that length times the solids' area.
+against the length rule in mm (`tolerance.STEP_LENGTH_MM`) and, for volumes, that length
+times the solids' area; every number shown at that tolerance. Only measured quantities are
+reported: the link's shape and motion are described by its mesh rows.
 
 Imported only when a STEP file's bytes differ, and Open CASCADE is loaded only when they
 differ by more than round-off of their numbers. A file Open CASCADE cannot read is reported
@@ -16,7 +18,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from simkit.diff_tol import PARAM_SI, REL, STEP_LENGTH_MM, text_close
+from simkit.diff.report import Change
+from simkit.diff.tolerance import PARAM_SI, REL, STEP_LENGTH_MM, text_close
 
 
 def step_stats(data: bytes) -> dict[str, dict] | None:
@@ -72,21 +75,20 @@ def _area(shape) -> float:
 
 
 def _solid_changes(a: dict, b: dict) -> list[tuple]:
-    """(field, old, new, unit) for one link's solids."""
+    """(field, old, new, unit, tolerance) for one link's solids: what was measured, never a
+    motion (a changed bounding box says where the solid reaches, not that it moved)."""
     out = []
-    tol = STEP_LENGTH_MM * max(a["area"], b["area"]) + REL * abs(a["volume"])
-    if abs(b["volume"] - a["volume"]) > tol:
-        out.append(("volume", round(a["volume"], 3), round(b["volume"], 3), "mm^3"))
+    tol = STEP_LENGTH_MM * max(a["area"], b["area"])
+    if abs(b["volume"] - a["volume"]) > tol + REL * abs(a["volume"]):
+        out.append(("volume", a["volume"], b["volume"], "mm^3", tol))
     moved = max((abs(x - y) for x, y in zip(a["bbox"], b["bbox"], strict=True)), default=0.0)
     if len(a["bbox"]) != len(b["bbox"]) or moved > STEP_LENGTH_MM:
-        boxes = [[round(v, 4) for v in box["bbox"]] for box in (a, b)]
-        out.append(("bbox", *boxes, "mm"))
+        out.append(("bbox", a["bbox"], b["bbox"], "mm", STEP_LENGTH_MM))
     return out
 
 
-def step_changes(old: dict[str, bytes], new: dict[str, bytes], change) -> list:
-    """`Change`s (the `change` class of diff.py) for every STEP file whose bytes differ by
-    more than round-off."""
+def step_changes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
+    """`Change`s for every STEP file whose bytes differ by more than round-off."""
     out = []
     for path in sorted(set(old) & set(new)):
         if not path.endswith(".step") or text_close(old[path], new[path], PARAM_SI):
@@ -96,10 +98,10 @@ def step_changes(old: dict[str, bytes], new: dict[str, bytes], change) -> list:
             state = ["readable" if s is not None else "unreadable" for s in (a, b)]
             if a is None and b is None:
                 state = ["unreadable", "unreadable, other bytes"]
-            out.append(change("step", path, "modified", "file", *state))
+            out.append(Change("step", path, "modified", "file", *state))
             continue
-        out += [change("step", name, "removed") for name in a if name not in b]
-        out += [change("step", name, "added") for name in b if name not in a]
+        out += [Change("step", name, "removed") for name in a if name not in b]
+        out += [Change("step", name, "added") for name in b if name not in a]
         for name in (n for n in b if n in a):
-            out += [change("step", name, "modified", *c) for c in _solid_changes(a[name], b[name])]
+            out += [Change("step", name, "modified", *c) for c in _solid_changes(a[name], b[name])]
     return out

@@ -1,29 +1,29 @@
-"""`simkit diff OLD NEW`: what changed between two kits, for a pull request review.
+"""The kit walk of `simkit diff OLD NEW`: what changed between two kits, for a pull request.
 
-Compares two kit folders or zips: joints (limits, speeds, torques, drive, origin, axis),
-links (mass, CoM, inertia), links and joints added or removed (all from robot.json), each
-mesh as a placed piece in its link frame (displacement, rotation, shape, volume, bounding
-box: diff_mesh.py), each link's number of convex collision pieces, each STEP solid's volume
-and bounding box (diff_step.py), other robot.json values that changed, and files added,
-removed or changed. Every number is compared with the tolerance the checks use for its
-quantity (diff_tol.py): a difference below it is round-off, not a change. Two kits are
-equal when nothing changed beyond round-off; `identical` when every file is byte-identical.
-Markdown for people (diff_text.py), JSON for machines.
+Compares two kits read by `kit.load_kit`: joints (limits, speeds, torques, drive, origin,
+axis), links (mass, CoM, inertia), links and joints added or removed (all from robot.json),
+each mesh as a placed piece in its link frame (`mesh`), each link's number of convex
+collision pieces, each STEP solid's volume and bounding box (`step`), other robot.json
+values that changed, and files added, removed or changed (GLB and USD: `scene`). Every
+number is compared with the tolerance the checks use for its quantity (`tolerance`): a
+difference below it is round-off, not a change. Two kits are equal when nothing changed
+beyond round-off; `identical` when every file is byte-identical.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import re
-from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from simkit.diff_mesh import glb_close, mesh_changes, usd_close
-from simkit.diff_tol import PARAM_SI, leaf_changes, same, text_close, tolerance
+from simkit.diff.kit import load_kit
+from simkit.diff.mesh import mesh_changes
+from simkit.diff.report import Change, Report
+from simkit.diff.scene import glb_close, usd_close
+from simkit.diff.step import step_changes
+from simkit.diff.tolerance import PARAM_SI, leaf_changes, same, text_close, tolerance
 from simkit.errors import SimkitError
 from simkit.kitio import layout
-from simkit.kitio.kitread import read_folder_safely, read_zip_safely, robot_json_problem
 
 #: robot.json joint fields compared, with their units (angles of prismatic joints are m).
 JOINT_FIELDS = {
@@ -57,127 +57,6 @@ MAX_LEAVES = 8
 COLLISION_PIECE = re.compile(r"^meshes/collision/(.+)_(\d+)\.(?:stl|obj)$")
 
 
-@dataclass(frozen=True)
-class Change:
-    """One semantic change: `kind` is joint, link, mesh, collision, step or robot_json; `change`
-    is modified, added or removed."""
-
-    kind: str
-    name: str
-    change: str = "modified"
-    field: str = ""
-    old: object = None
-    new: object = None
-    unit: str = ""
-
-
-@dataclass
-class Report:
-    old: str
-    new: str
-    changes: list[Change] = field(default_factory=list)
-    added: list[str] = field(default_factory=list)
-    removed: list[str] = field(default_factory=list)
-    changed: list[str] = field(default_factory=list)
-    #: files whose bytes differ only below the tolerances or in METADATA_KEYS
-    round_off: list[str] = field(default_factory=list)
-    #: METADATA_KEYS values that changed (paths such as provenance.spec_sha256)
-    metadata: list[str] = field(default_factory=list)
-
-    @property
-    def equal(self) -> bool:
-        """Nothing changed beyond round-off."""
-        return not (self.changes or self.added or self.removed or self.changed)
-
-    @property
-    def identical(self) -> bool:
-        return self.equal and not self.round_off
-
-    def to_json(self) -> str:
-        """The report as strict JSON (a NaN or infinity read from a kit becomes a string)."""
-        doc = {
-            "equal": self.equal,
-            "identical": self.identical,
-            "old": self.old,
-            "new": self.new,
-            "changes": [asdict(c) for c in self.changes],
-            "files": {
-                "added": self.added,
-                "removed": self.removed,
-                "changed": self.changed,
-                "round_off": self.round_off,
-            },
-            "metadata": self.metadata,
-        }
-        return json.dumps(_finite(doc), indent=2, allow_nan=False) + "\n"
-
-
-def _finite(value):
-    """`value` with every non-finite float as the string JSON readers know it by."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return "NaN" if math.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    return value
-
-
-def _read_zip(path: Path) -> dict[str, bytes]:
-    """Files of a kit zip, keyed by path inside the kit (`archive.read_zip`'s top-folder
-    rule), read with `kitread`'s caps, or a one-line error for anything else."""
-    files = read_zip_safely(path)
-    tops = {name.partition("/")[0] if "/" in name else None for name in files}
-    if len(tops) == 1 and None not in tops:
-        return {name.partition("/")[2]: data for name, data in files.items()}
-    return files
-
-
-def load_kit(path: Path) -> dict[str, bytes]:
-    """Files of a kit folder or kit zip, keyed by POSIX path inside the kit. A kit has a
-    robot.json at its top; anything else is refused rather than reported as all removed."""
-    if path.is_file():
-        files = _read_zip(path)
-    elif path.is_dir():
-        files = read_folder_safely(path)
-    else:
-        raise SimkitError(f"{path}: no such kit folder or zip")
-    if layout.ROBOT_JSON not in files:
-        raise SimkitError(f"{path}: not a kit (no {layout.ROBOT_JSON} at its top)")
-    why = robot_json_problem(files[layout.ROBOT_JSON])
-    if why:
-        raise SimkitError(f"{path}: {layout.ROBOT_JSON} {why}")
-    return files
-
-
-def materialize(files: dict[str, bytes], dest: Path) -> Path:
-    """Write a kit read by `load_kit` (confined, plain files) under the empty folder `dest`,
-    for readers that need files on disk (`simkit check KIT.zip`). A path that is both a file
-    and a folder is refused in one line."""
-    for rel in sorted(files):
-        path = dest / rel
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with open(path, "xb") as handle:  # never through a link, never over a file
-                handle.write(files[rel])
-        except OSError as exc:
-            raise SimkitError(f"{rel}: cannot be extracted ({exc.strerror or exc})") from None
-    return dest
-
-
-def unpacked(zip_path: Path, files: dict[str, bytes], tmp: Path) -> Path:
-    """A kit zip as a build lays it out, under the empty folder `tmp`: the files under
-    `NAME_description/` and the zip itself beside them, so the checks that compare the two
-    run as on a build (`simkit check KIT.zip`). A robot name unfit for a folder name (any
-    character beyond [A-Za-z0-9_]) unpacks as `kit/`, without the zip."""
-    name = str(json.loads(files[layout.ROBOT_JSON]).get("name", ""))
-    if not re.fullmatch(r"[A-Za-z0-9_]{1,100}", name):
-        return materialize(files, tmp / "kit")
-    kit = materialize(files, tmp / layout.kit_dir_name(name))
-    (tmp / layout.zip_name(name)).write_bytes(zip_path.read_bytes())
-    return kit
-
-
 def _robot_json(files: dict[str, bytes]) -> dict:
     data = files.get(layout.ROBOT_JSON)
     return json.loads(data) if data else {}
@@ -205,7 +84,7 @@ def _entities(
                 unit = "m"
             x, y = _flat(a.get(key)), _flat(b.get(key))
             if not same(x, y, tolerance(unit)):
-                out.append(Change(kind, name, "modified", key, x, y, unit))
+                out.append(Change(kind, name, "modified", key, x, y, unit, tolerance(unit)))
         out += _other_fields(kind, name, a, b, fields)
     return out
 
@@ -227,8 +106,7 @@ def _meshes(old: dict[str, bytes], new: dict[str, bytes]) -> list[Change]:
     out = []
     for path in sorted(set(old) & set(new)):
         if path.endswith((".stl", ".obj")) and old[path] != new[path]:
-            changes = mesh_changes(path, old[path], new[path])
-            out += [Change("mesh", path, "modified", *c) for c in changes]
+            out += mesh_changes(path, old[path], new[path])
     return out
 
 
@@ -295,9 +173,7 @@ def diff_files(
     )
     report.changes += _meshes(old, new)
     if any(p.endswith(".step") for p in differ):
-        from simkit.diff_step import step_changes
-
-        report.changes += step_changes(old, new, Change)
+        report.changes += step_changes(old, new)
     pieces_a, pieces_b = _pieces(old), _pieces(new)
     for link in sorted(set(pieces_a) | set(pieces_b)):
         if pieces_a.get(link, 0) != pieces_b.get(link, 0):

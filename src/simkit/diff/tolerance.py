@@ -23,7 +23,7 @@ INERTIA_KG_M2 = 1e-7
 PARAM_SI = 1e-6
 #: relative: every written number carries 10 significant digits (kitio/fmt.py)
 REL = 1e-9
-#: STEP solids are compared in mm (diff_step.py): the length rule in mm and mm^3
+#: STEP solids are compared in mm (diff/step.py): the length rule in mm and mm^3
 STEP_LENGTH_MM = LENGTH_M * 1000
 
 #: tolerance by unit, for robot.json fields
@@ -87,3 +87,21 @@ def text_close(a: bytes, b: bytes, tol: float = PARAM_SI) -> bool:
         close(float(x), float(y), tol)
         for x, y in zip(NUMBER.findall(a), NUMBER.findall(b), strict=True)
     )
+
+
+def decimals(tol: float) -> int:
+    """Decimal places that resolve `tol`: 1e-6 -> 6, 3e-7 -> 7, 0.05 -> 2."""
+    return math.ceil(-math.log10(tol) - 1e-9)
+
+
+def quantize(value: object, tol: float) -> object:
+    """`value` shown at its quantity's tolerance (issue 34): every number rounded to the
+    decimal places that resolve `tol`, a number below `tol` 0, lists and dicts element by
+    element; words, booleans, integers, non-finite numbers and `tol` <= 0 as they are."""
+    if isinstance(value, float) and tol > 0 and math.isfinite(value):
+        return 0.0 if abs(value) < tol else round(value, decimals(tol)) + 0.0
+    if isinstance(value, (list, tuple)):
+        return [quantize(v, tol) for v in value]
+    if isinstance(value, dict):
+        return {k: quantize(v, tol) for k, v in value.items()}
+    return value
