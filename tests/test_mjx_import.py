@@ -101,7 +101,12 @@ def kits(tmp_path_factory) -> dict[str, Path]:
 @pytest.fixture(scope="module")
 def probes(kits) -> dict[str, dict]:
     done = subprocess.run(
-        [sys.executable, str(REPO / "scripts" / "bench_gpu.py"), "--probe", *map(str, kits.values())],
+        [
+            sys.executable,
+            str(REPO / "scripts" / "bench_gpu.py"),
+            "--probe",
+            *map(str, kits.values()),
+        ],
         capture_output=True,
         text=True,
         timeout=900,
