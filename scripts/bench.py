@@ -14,6 +14,12 @@ collision pieces, and visual and collision triangles.
     python scripts/bench.py rosie_1000 tests/specs/collision_mix.yaml --warm 5 --json out.json
     python scripts/bench.py rosie_1000 --compare-step 3   # what the STEP assembly adds
     python scripts/bench.py rosie_1000 /tmp/imported/humanoid.yaml --warm 1 --noop 5
+    python scripts/bench.py --step-rate build/rosie_1000_description/mjcf/rosie_1000.xml OTHER.xml
+
+`--step-rate MJCF ...` instead times C MuJoCo stepping each model file (issue 30): single
+thread, from its first keyframe (or qpos0) with the servos holding it, `STEP_RATE_STEPS`
+steps a round, the rounds of all the files interleaved so that they share the machine's state
+(median steps/s).
 """
 
 from __future__ import annotations
@@ -131,6 +137,33 @@ def bench(
     }
 
 
+STEP_RATE_STEPS = 20_000
+STEP_RATE_ROUNDS = 7
+
+
+def _step_once(path: Path) -> float:
+    """Steps per second of one round of C MuJoCo on the model file."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    if model.nkey:
+        mujoco.mj_resetDataKeyframe(model, data, 0)
+    start = time.perf_counter()
+    for _ in range(STEP_RATE_STEPS):
+        mujoco.mj_step(model, data)
+    return STEP_RATE_STEPS / (time.perf_counter() - start)
+
+
+def step_rates(paths: list[Path]) -> dict[str, float]:
+    """Median steps/s of each model file, the rounds interleaved."""
+    rounds: dict[str, list[float]] = {str(p): [] for p in paths}
+    for _ in range(STEP_RATE_ROUNDS):
+        for path in paths:
+            rounds[str(path)].append(_step_once(path))
+    return {name: statistics.median(values) for name, values in rounds.items()}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("targets", nargs="*", help="robot names or spec paths (default: rosie_*)")
@@ -149,7 +182,17 @@ def main() -> None:
     parser.add_argument(
         "--step-parts", action="store_true", help="only time the parts of the STEP work"
     )
+    parser.add_argument(
+        "--step-rate", nargs="+", type=Path, metavar="MJCF", help="only time C MuJoCo stepping"
+    )
     args = parser.parse_args()
+    if args.step_rate:
+        rates = step_rates(args.step_rate)
+        base = next(iter(rates.values()))
+        print("| model | steps/s (median) | ratio to the first |\n|---|---|---|")
+        for name, rate in rates.items():
+            print(f"| {name} | {rate:,.0f} | {rate / base:.2f} |")
+        return
     targets = args.targets
     if args.step_parts:
         for target in targets:

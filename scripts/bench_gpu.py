@@ -152,6 +152,12 @@ def mjx_rate(path: Path, worlds: int, steps: int) -> dict:
     }
 
 
+def warp_sizes(model) -> dict[str, int]:
+    """The file's own `<size nconmax njmax>` for MuJoCo Warp (contacts and constraint rows per
+    world); Warp's defaults where the file sets none."""
+    return {k: int(getattr(model, k)) for k in ("nconmax", "njmax") if getattr(model, k) >= 0}
+
+
 def warp_rate(path: Path, worlds: int, steps: int) -> dict | None:
     """MuJoCo Warp steps per second, or None where mujoco_warp is not installed."""
     try:
@@ -164,7 +170,7 @@ def warp_rate(path: Path, worlds: int, steps: int) -> dict | None:
     model = mujoco.MjModel.from_xml_path(str(path))
     data = start_state(model)
     m = mjw.put_model(model)
-    d = mjw.put_data(model, data, nworld=worlds, nconmax=model.nconmax, njmax=model.njmax)
+    d = mjw.put_data(model, data, nworld=worlds, **warp_sizes(model))
     started = time.perf_counter()
     mjw.step(m, d)
     wp.synchronize()
@@ -193,7 +199,7 @@ def warp_probe(kit: Path, steps: int = 10) -> dict:
 
     model = mujoco.MjModel.from_xml_path(str(gpu_scene(kit)))
     m = mjw.put_model(model)
-    d = mjw.put_data(model, start_state(model), nworld=2, nconmax=model.nconmax, njmax=model.njmax)
+    d = mjw.put_data(model, start_state(model), nworld=2, **warp_sizes(model))
     for _ in range(steps):
         mjw.step(m, d)
     wp.synchronize()
