@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 
+from simkit.model.kinematics import forward
+
 #: the axis direction the limbs point along -> floating joint rpy (rad) turning it to -z
 DIRECTIONS = {
     "+x": (np.array([1.0, 0.0, 0.0]), (0.0, math.pi / 2, 0.0)),
@@ -79,8 +81,6 @@ def limb_ends(robot, poses: dict, base: str) -> np.ndarray:
 def upright(robot) -> tuple[tuple[float, float, float], str] | None:
     """The floating joint's rpy (rad) that stands the robot on its limbs, and why; None where
     the identity does (the limbs hang along -z, or nothing tells)."""
-    from simkit.model.kinematics import forward
-
     floating = robot.floating_joint
     if floating is None:
         return None

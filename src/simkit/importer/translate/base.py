@@ -16,7 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.importer.source import Source
+from simkit.importer.read.source import Source
+from simkit.importer.translate.convert import tree
+from simkit.importer.translate.geometry import origin
+from simkit.model.kinematics import rpy_matrix
 
 #: share of the robot's height span (z at the zero pose) a leg reaches below the root
 LEG = 0.25
@@ -28,9 +31,6 @@ RANGED = ("revolute", "prismatic", "spherical")  # a limb with only continuous j
 
 def _transform(source: Source, element) -> np.ndarray:
     """The 4x4 pose of an element's `<origin>` (m, rad)."""
-    from simkit.importer.geometry import origin
-    from simkit.model.kinematics import rpy_matrix
-
     xyz, rpy = origin(source, element)
     out = np.eye(4)
     out[:3, :3] = rpy_matrix(rpy)
@@ -93,8 +93,6 @@ def _limbs(links: dict, by_child: dict, root: str) -> list[list[str]]:
 
 def decide(source: Source) -> tuple[bool, str]:
     """(floating, the report line's reason) from the URDF's structure."""
-    from simkit.importer.convert import tree
-
     links, by_child, root = tree(source)
     points = _points(source, links, by_child, root)
     every = np.vstack(list(points.values()))

@@ -6,12 +6,16 @@ import math
 
 import numpy as np
 
-from simkit.importer import inertia_limit
-from simkit.importer.geometry import floats, origin, shape_of
-from simkit.importer.meshes import MeshWriter
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.importer.translate import inertia_limit
+from simkit.importer.translate.geometry import floats, origin, shape_of
+from simkit.importer.translate.masses import solid_mass
+from simkit.importer.translate.meshes import MeshWriter
+from simkit.model.kinematics import rpy_matrix
 from simkit.spec.bounds import FIELD_BOUNDS
+from simkit.spec.schema import InertiaSpec
+from simkit.spec.validate import inertia_problem
 
 #: kg and kg m^2 given to a link the URDF leaves massless (MuJoCo needs mass on moving bodies)
 MASSLESS_MASS, MASSLESS_INERTIA = 0.001, 1.0e-7
@@ -36,17 +40,12 @@ def has_geometry(link) -> bool:
 
 
 def _rotated(tensor: np.ndarray, rpy) -> np.ndarray:
-    from simkit.model.kinematics import rpy_matrix
-
     rot = rpy_matrix(rpy)
     return rot @ tensor @ rot.T
 
 
 def inertial(source: Source, link, report: Report) -> dict:
     """mass, com, inertia (about the CoM, link axes) and the estimates and decision made."""
-    from simkit.spec.schema import InertiaSpec
-    from simkit.spec.validate import inertia_problem
-
     element = link.find("inertial")
     if not has_mass(link):
         report.estimated(
@@ -191,8 +190,6 @@ def link_spec(
 def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dict:
     """A massless link's mass, CoM and inertia: its visual solid's at `density` (kg/m^3),
     estimated and reported; the placeholder speck (`inertial`) where it has no volume."""
-    from simkit.importer.masses import solid_mass
-
     found = solid_mass(solid, writer.out_dir, density) if solid else None
     if found is None or found[0] < MIN_MASS:
         return inertial(source, link, report)

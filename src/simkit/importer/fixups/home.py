@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.collide import (
+from simkit.importer.fixups.collide import (
     always_touching,
     between,
     collision_shapes,
@@ -30,6 +30,7 @@ from simkit.importer.collide import (
     touching,
     within_limits,
 )
+from simkit.importer.fixups.scratch import compiled
 
 GRID = 8  # range divisions tried per joint
 #: rad or m: turns (slides) from the first guess tried before the grid
@@ -63,14 +64,10 @@ def free_home(robot, base_dir: Path, every: bool = False) -> tuple[list[float], 
 def _search(robot, base_dir: Path, start, follow, shapes_of, every: bool = False) -> np.ndarray:
     """A pose free of contact on the model of `shapes_of`, from `start` (see free_home);
     `start` when it is free already or no free pose is found."""
-    import mujoco
-
     movable = robot.movable_joints
     index = {j.name: i for i, j in enumerate(movable)}
     always = () if every else always_touching(robot, base_dir, start, follow, shapes_of)
-    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, always, shapes_of))
-    data = mujoco.MjData(model)
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    model, data, adr = compiled(model_xml(robot, base_dir, always, shapes_of), movable)
     q = start.copy()
     best, pairs = penetration(model, data, adr, q)
     if not touching(data):  # closer than the clearance is fine at the first guess
@@ -103,15 +100,11 @@ def _search(robot, base_dir: Path, start, follow, shapes_of, every: bool = False
 def in_contact(robot, base_dir: Path) -> bool:
     """Whether two links that the kit lets collide touch at the spec's home (the first
     search's model: collision shapes, the always-touching pairs left out)."""
-    import mujoco
-
     start, follow = posed(robot)
     if start is None:
         return False
     always = always_touching(robot, base_dir, start, follow, collision_shapes)
-    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, always, collision_shapes))
-    data = mujoco.MjData(model)
-    movable = robot.movable_joints
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    xml = model_xml(robot, base_dir, always, collision_shapes)
+    model, data, adr = compiled(xml, robot.movable_joints)
     penetration(model, data, adr, start)
     return touching(data)

@@ -16,12 +16,15 @@ from __future__ import annotations
 
 import itertools
 import math
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.collide import add_bodies, between, geom
+from simkit.importer.fixups.alike import group_search
+from simkit.importer.fixups.collide import between
+from simkit.importer.fixups.scratch import Scratch, compiled
+from simkit.importer.fixups.standing import floor_shapes, points
+from simkit.model.kinematics import forward
 
 GRID = 8  # range divisions tried per joint
 SWEEPS = 2
@@ -41,18 +44,13 @@ def stance_shapes(link) -> tuple:
 
 
 def model_xml(robot, base_dir: Path) -> str:
-    """Collision geometry only; every body but a fixed joint's child moves (fixed children
-    are welded, as MuJoCo does in the kit), the parent filter on."""
-    root = ET.Element("mujoco")
-    ET.SubElement(root, "compiler", angle="radian")
-    ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
-    add_bodies(root, robot, base_dir, stance_shapes, geom)
-    contact = ET.SubElement(root, "contact")
+    """Collision geometry only (scratch.py); every body but a fixed joint's child moves
+    (fixed children are welded, as MuJoCo does in the kit), the parent filter on."""
+    scratch = Scratch(compiler={"angle": "radian"}, geom={"contype": "1", "conaffinity": "1"})
+    scratch.tree(robot, base_dir, stance_shapes)
     links = {link.name for link in robot.links}
-    for joint in robot.joints:
-        if joint.parent in links:
-            ET.SubElement(contact, "exclude", body1=joint.parent, body2=joint.child)
-    return ET.tostring(root, encoding="unicode")
+    scratch.exclude((j.parent, j.child) for j in robot.joints if j.parent in links)
+    return scratch.xml()
 
 
 def contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
@@ -73,9 +71,6 @@ def contacts(model, data, adr, q) -> dict[tuple[str, str], float]:
 
 def _feet_joints(robot, home, base_dir: Path) -> set[str]:
     """Joints on the way from the base to any link whose lowest point at home is a foot."""
-    from simkit.importer.standing import floor_shapes, points
-    from simkit.model.kinematics import forward
-
     poses = forward(robot, home)
     low: dict[str, float] = {}
     for link in robot.links:
@@ -109,8 +104,6 @@ class Support:
     centre of mass lies (the geometry that touches the floor, as standing.py places it)."""
 
     def __init__(self, robot, base_dir: Path):
-        from simkit.importer.standing import floor_shapes, points
-
         self.robot = robot
         self.points = {
             link.name: np.vstack([points(shape, base_dir) for shape in floor_shapes(link)])
@@ -136,8 +129,6 @@ class Support:
         -inf unless every lowest point is on the base or links welded to it (no servo
         carries the weight)."""
         from scipy.spatial import ConvexHull, QhullError
-
-        from simkit.model.kinematics import forward
 
         poses = forward(self.robot, list(q))
         world = [pts @ poses[n][:3, :3].T + poses[n][:3, 3] for n, pts in self.points.items()]
@@ -223,9 +214,6 @@ def _pair_search(q, depth, robot, model, data, adr, always, frozen, limits, inde
 
 def _alike(q, depth, robot, index, movable) -> np.ndarray:
     """alike.group_search from `q`, mimic joints following."""
-    from simkit.importer.alike import group_search
-    from simkit.model.kinematics import forward
-
     poses = forward(robot, list(q))
     return group_search(
         q, depth, robot, poses, index, lambda t: _follow(t[None, :], movable, index)[0]
@@ -237,15 +225,11 @@ def free_home(robot, base_dir: Path, rest: bool = True) -> tuple[list[float], li
     robot rests on the floor (its CoM at least MARGIN inside its support), and the changes
     made (`joint: a -> b`); None when home already is, or no grid pose is better. `rest`
     False: no floor (a legged robot bolted at its base): free of contact, legs kept."""
-    import mujoco
-
     home = dict(robot.poses).get("home")
     if home is None:
         return None
-    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir))
-    data = mujoco.MjData(model)
     movable = robot.movable_joints
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    model, data, adr = compiled(model_xml(robot, base_dir), movable)
     limits = [(j.lower, j.upper) if j.lower is not None else (-math.pi, math.pi) for j in movable]
     index = {j.name: i for i, j in enumerate(movable)}
     lo, hi = np.array(limits, dtype=float).T

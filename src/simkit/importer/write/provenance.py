@@ -12,9 +12,10 @@ URDF's names: `links.L.FIELD`, `joints.J.FIELD`, `links.L.name` (renamed, `kit` 
 from __future__ import annotations
 
 import hashlib
+from dataclasses import replace
 
-from simkit.importer.report import Report
-from simkit.importer.source import Source, describe, line_of
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source, describe, line_of
 from simkit.kitio.oneline import one_line
 from simkit.spec.bounds import MAX_STRING
 
@@ -44,7 +45,6 @@ def as_read(source: Source) -> Source:
     spherical joint becomes three joints in place, ball_joints.py): what the kit is
     compared with. Line numbers are kept, so report lines still match its elements."""
     import copy
-    from dataclasses import replace
 
     return replace(source, root=copy.deepcopy(source.root))
 
@@ -84,8 +84,8 @@ def differences(
             add(f"{key}.{old}.name", f"renamed: '{old}' is not a name the kit can hold", new)
     _added(spec, source, back, add)
     _frames(spec, source, back, add)
-    lines = Said(report)
-    _reshaped(spec, source, lines, back, add)
+    records = Said(report)
+    _reshaped(spec, source, records, back, add)
     for kind, fields in COMPARED.items():
         tag = kind[:-1]
         named: dict = {}  # the first element of each name, as `find` gives it
@@ -94,12 +94,12 @@ def differences(
         for item in spec.get(kind, []):
             old = back.get(item["name"], item["name"])
             element = named.get(_quoted(old))
-            said = _said(lines, source, element)
+            said = _said(records, source, element)
             for field in item.get("estimated", []):
                 if field in fields:
                     add(f"{kind}.{old}.{field}", said or GENERIC[field])
             if kind == "links" and element is not None:
-                _dropped(lines, source, element, f"links.{old}", add)
+                _dropped(records, source, element, f"links.{old}", add)
             if kind == "links" and item.get("inertia_decision"):
                 add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
             if kind == "joints" and element is not None and element.get("type") != item["type"]:
@@ -189,30 +189,27 @@ def _dropped(report: Said, source: Source, link, key: str, add) -> None:
 
 
 class Said:
-    """The report's lines, indexed by each `FILE:LINE: ELEMENT: ` prefix they may start
-    with, so that finding an element's lines takes time in its lines, not in the report's
-    (a chain of thousands of links has thousands of each)."""
+    """The report's records about each source element, indexed by (file name, line,
+    element), so that finding an element's records takes time in its records, not in the
+    report's (a chain of thousands of links has thousands of each). A record of no known
+    line names no element of the kept source."""
 
     def __init__(self, report: Report) -> None:
-        self.lines = tuple(report.lines)
-        self.index: dict[str, list[int]] = {}
-        for i, line in enumerate(self.lines):
-            at = line.find(": ")
-            while at >= 0:
-                self.index.setdefault(line[: at + 2], []).append(i)
-                at = line.find(": ", at + 1)
+        self.index: dict[tuple[str, int, str], list[tuple[int, str]]] = {}
+        for i, record in enumerate(report.records):
+            if record.line is not None:
+                key = (record.file.name, record.line, record.element)
+                self.index.setdefault(key, []).append((i, f"{record.kind}: {record.message}"))
 
 
 def _said(report: Said, source: Source, element) -> str:
-    """The report's messages about `element` or an element inside it (each report line
-    starts `FILE:LINE: ELEMENT: `, so a URDF on one line still tells a link from a joint),
-    in report order."""
+    """The report's `KIND: message` about `element` or an element inside it, in report
+    order, the first four joined by '; '."""
     if element is None:
         return ""
-    prefixes = {f"{source.path.name}:{line_of(e)}: {describe(e)}: " for e in element.iter()}
-    hits = sorted((i, p) for p in prefixes for i in report.index.get(p, ()))
-    said = [report.lines[i][len(p) :] for i, p in hits]
-    return "; ".join(said[:4])
+    keys = {(source.path.name, line_of(e), describe(e)) for e in element.iter()}
+    hits = sorted(hit for key in keys for hit in report.index.get(key, ()))
+    return "; ".join(said for _, said in hits[:4])
 
 
 def _quoted(name: str) -> str:

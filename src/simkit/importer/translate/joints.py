@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import math
 
-from simkit.importer.geometry import floats, origin, placed
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.importer.translate.geometry import floats, origin, placed
 from simkit.spec.bounds import FIELD_BOUNDS, TURNS
 
 TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating"}

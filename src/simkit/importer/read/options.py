@@ -2,7 +2,7 @@
 
 Downloaded URDFs and xacros are untrusted: by default the reader reads no environment
 variable, no file outside the robot's package folders, and evaluates xacro expressions with
-a restricted evaluator (importer/safe_eval.py). Each permission is given by name.
+a restricted evaluator (importer/read/safe_eval.py). Each permission is given by name.
 """
 
 from __future__ import annotations

@@ -16,7 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.meshes import Y_UP_TO_Z_UP, is_y_up
+from simkit.importer.read.source import resolve_uri
+from simkit.importer.translate.geometry import floats, origin
+from simkit.importer.translate.meshes import Y_UP_TO_Z_UP, is_y_up
+from simkit.model.kinematics import rpy_matrix
 
 SLACK = 0.01  # m a child joint origin may lie outside its link's mesh bounds
 
@@ -35,10 +38,6 @@ def _vertices(path: Path, scale) -> np.ndarray | None:
 def _fit(source, link, kids: list[np.ndarray], turn: bool) -> tuple[int, float] | None:
     """(child joint origins inside the link's Y_UP visual meshes' bounds, distance m of their
     centroid from the inertial CoM) with the meshes turned or not; None without such a mesh."""
-    from simkit.importer.geometry import floats, origin
-    from simkit.importer.source import resolve_uri
-    from simkit.model.kinematics import rpy_matrix
-
     points = []
     for visual in link.findall("visual"):
         mesh = visual.find("geometry/mesh")
@@ -71,8 +70,6 @@ def _fit(source, link, kids: list[np.ndarray], turn: bool) -> tuple[int, float] 
 def turn_y_up(source) -> tuple[bool, str]:
     """Whether this URDF's Y_UP COLLADA meshes are to be turned Z-up, and why (a report
     line; empty when they stay as stored)."""
-    from simkit.importer.geometry import origin
-
     kids: dict[str, list[np.ndarray]] = {}
     for joint in source.root.findall("joint"):
         parent = joint.find("parent")

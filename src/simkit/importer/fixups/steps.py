@@ -5,7 +5,7 @@ zero pose is kept unless links collide, a servo cannot hold it, or a floating ba
 place to stand), and gives each change one report line with its reason:
 
 0. `rotors`: each driven joint's estimated rotor inertia (armature), bounded by what the
-   joint moves (masses.py).
+   joint moves (rotors.py).
 1. `base`: a floating robot drawn Y-up is turned to stand on its limbs (upright.py).
 2. `home`: out of self-contact: any joint between touching links may move for a fixed base
    (home.py), then to where the servos hold it against gravity (gravity.py); a floating
@@ -20,6 +20,10 @@ place to stand), and gives each change one report line with its reason:
 from __future__ import annotations
 
 from simkit.importer.draft import Draft
+from simkit.importer.fixups import gravity, settle, stance, standing, upright
+from simkit.importer.fixups import home as clear
+from simkit.importer.fixups import limits as ranges
+from simkit.importer.fixups.rotors import armature
 
 #: links above which the fix-ups that compile a MuJoCo model of the robot (home's contact
 #: and gravity searches, the floating rest, limits narrowing) are skipped, one report line
@@ -45,8 +49,6 @@ def searched(draft: Draft, what: str) -> bool:
 
 def base(draft: Draft) -> None:
     """A Y-up floating robot lies on its side at the identity: turn its base."""
-    from simkit.importer import upright
-
     if not draft.floating:
         return
     turned = upright.upright(draft.robot())
@@ -57,9 +59,6 @@ def base(draft: Draft) -> None:
 
 def home(draft: Draft) -> None:
     """`home` out of self-contact; for a fixed base, also held against gravity."""
-    from simkit.importer import gravity, stance
-    from simkit.importer import home as free
-
     if not searched(draft, "home out of self-contact and held against gravity"):
         return
     if draft.floating:  # stance.py: out of self-contact with the feet kept
@@ -71,10 +70,10 @@ def home(draft: Draft) -> None:
         return
     why = "the links collide at the first guess (0, or mid-range outside the limits)"
     if draft.legged:  # bolted at the pelvis: the legs hang as they are, the arms move
-        found = _bolted_home(draft) if free.in_contact(draft.robot(), draft.stage) else None
+        found = _bolted_home(draft) if clear.in_contact(draft.robot(), draft.stage) else None
     else:
-        found = free.free_home(draft.robot(), draft.stage)
-        if found is None and free.in_contact(draft.robot(), draft.stage):
+        found = clear.free_home(draft.robot(), draft.stage)
+        if found is None and clear.in_contact(draft.robot(), draft.stage):
             found = _bolted_home(draft)
     draft.set_home(found, why)
     held = gravity.held_home(draft.robot(), draft.stage)
@@ -86,9 +85,6 @@ def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:
     """Where one joint at a time cannot part the links (a humanoid bolted at the pelvis, its
     hands inside its thighs): the stance search with the legs kept as they hang (stance.py),
     then home.py's clearance search from there; the changes from the first guess."""
-    from simkit.importer import home as free
-    from simkit.importer import stance
-
     found = stance.free_home(draft.robot(), draft.stage, rest=False)
     if found is None:
         return None
@@ -97,7 +93,7 @@ def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:
     draft.changed()
     pose = found[0]
     for every in (False, True):  # then pairs the search took for always touching (the kit
-        polished = free.free_home(draft.robot(), draft.stage, every)  # samples more)
+        polished = clear.free_home(draft.robot(), draft.stage, every)  # samples more)
         if polished is not None:
             pose = draft.spec["poses"]["home"] = polished[0]
             draft.changed()
@@ -112,8 +108,6 @@ def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:
 def stand(draft: Draft) -> None:
     """Raise a floating base so that the robot stands on the floor at home, then start it
     where it comes to rest when it tips onto its frame (a flying arm)."""
-    from simkit.importer import standing
-
     if not draft.floating and not draft.legged:
         return
     height = standing.standing_height(draft.robot(), draft.stage)
@@ -141,8 +135,6 @@ def stand(draft: Draft) -> None:
 def _settle(draft: Draft) -> None:
     """The free joint where the robot comes to rest at home when that is tilted onto its
     frame (settle.py), and the home its servos hold that rest with."""
-    from simkit.importer import settle
-
     if not searched(draft, "the rest on the frame"):
         return
     found = settle.rest_pose(draft.robot(), draft.stage)
@@ -169,22 +161,18 @@ def _settle(draft: Draft) -> None:
 def limits(draft: Draft) -> None:
     """Estimated position limits narrowed to the joint's range free of self-contact from
     home (limits.py), one report line per joint."""
-    from simkit.importer import limits as free
-
     if not searched(draft, "estimated limits narrowed to the range free of self-contact"):
         return
-    found = free.narrowed(draft.robot(), draft.stage)
+    found = ranges.narrowed(draft.robot(), draft.stage)
     if not found:
         return
-    source = draft.source
     for joint in draft.spec["joints"]:
         if joint["name"] in found:
             old = (joint["lower"], joint["upper"])
             joint["lower"], joint["upper"] = found[joint["name"]]
-            element = source.root.find(f"joint[@name='{joint['name']}']")
             draft.report.assumed(
-                source,
-                source.root if element is None else element,
+                draft.source,
+                draft.where("joint", joint["name"]),
                 f"estimated limits {old[0]:.4g} .. {old[1]:.4g} narrowed to "
                 f"{joint['lower']:.4g} .. {joint['upper']:.4g}, the range the joint turns "
                 "from home without self-contact",
@@ -193,9 +181,7 @@ def limits(draft: Draft) -> None:
 
 
 def rotors(draft: Draft) -> None:
-    """Estimated armature per driven joint (masses.armature)."""
-    from simkit.importer.masses import armature
-
+    """Estimated armature per driven joint (rotors.armature)."""
     armature(draft)
 
 

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from simkit.importer.lenient import first_numbers, loose_numbers
-from simkit.importer.meshes import MeshWriter
-from simkit.importer.report import Report
-from simkit.importer.source import MissingMesh, Source, resolve_uri
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.lenient import first_numbers, loose_numbers
+from simkit.importer.read.source import MissingMesh, Source, resolve_uri
+from simkit.importer.translate.meshes import MeshWriter
+from simkit.importer.translate.solids import estimated_box
 
 
 def floats(source: Source, element, attr: str, count: int, default: str | None = None):
@@ -132,7 +133,7 @@ def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: 
 
 def _missing(source: Source, element, shape, why: str, what: str):
     """A mesh no rule finds: this geometry is left out (as PyBullet does), reported; a link
-    left with no geometry at all gets an estimated box instead (importer/solids.py)."""
+    left with no geometry at all gets an estimated box instead (importer/translate/solids.py)."""
     link = element.getparent()
     if any(_usable(source, other) for other in link if other is not element):
         source.lenient(shape, f"{why}: this {what} is left out")
@@ -166,8 +167,6 @@ def _estimated_box(source: Source, link) -> dict:
     """The box solids.py gives a geometry-free link: bounding its origin, CoM and child
     joints, holding its mass (or the massless placeholder) at water's density."""
     import numpy as np
-
-    from simkit.importer.solids import estimated_box
 
     mass_el = link.find("inertial/mass")
     try:

@@ -26,6 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.importer.fixups import stance
+from simkit.importer.fixups.collide import always_touching, posed
+from simkit.importer.fixups.scratch import Scratch, compiled, text
+from simkit.importer.fixups.stance import Support, stance_shapes
+from simkit.importer.fixups.standing import floor_shapes, lowest
+from simkit.model.kinematics import forward
+
 SECONDS = 2.0  # s of settling
 TIMESTEP = 0.002  # s, as the kit's MJCF
 TILT = 0.02  # rad: a settled base turned less than this stays level
@@ -62,10 +69,6 @@ class Rest:
         return self.still and self.frame_down and self.tilt <= UPRIGHT and self.worst[1] <= LIMIT
 
 
-def _text(values) -> str:
-    return " ".join(repr(float(v)) for v in np.ravel(values))
-
-
 def _servos(robot) -> list:
     """Joints the kit drives: movable, actuated, no mimic, with an effort."""
     return [
@@ -75,91 +78,45 @@ def _servos(robot) -> list:
     ]
 
 
-def _principal(tensor) -> dict[str, str]:
-    """MJCF `diaginertia` and `quat` of an inertia tensor (kg m^2, link axes): its principal
-    moments, none below a speck (an inertia_decision may keep one that is not positive
-    definite, a quadruped's base)."""
-    from scipy.spatial.transform import Rotation
-
-    moments, axes = np.linalg.eigh(np.asarray(tensor, dtype=float))
-    if np.linalg.det(axes) < 0:
-        axes[:, 0] = -axes[:, 0]
-    moments = np.maximum(moments, 1e-12)  # the compiler balances a + b < c (balanceinertia)
-    x, y, z, w = Rotation.from_matrix(axes).as_quat()
-    return {"diaginertia": _text(moments), "quat": _text([w, x, y, z])}
-
-
-def _body(parent: ET.Element, link, base_dir: Path, asset, **attrs) -> ET.Element:
-    """A body with the link's real inertial and its collision shapes (floor contact only)."""
-    from simkit.importer.collide import geom
-    from simkit.importer.stance import stance_shapes
-
-    body = ET.SubElement(parent, "body", name=link.name, **attrs)
-    inertial = link.inertial
-    if inertial is not None and inertial.mass > 0:
-        ET.SubElement(
-            body,
-            "inertial",
-            pos=_text(inertial.com),
-            mass=repr(float(inertial.mass)),
-            **_principal(inertial.tensor()),
-        )
-    else:  # a massless link: a speck, so MuJoCo accepts a moving body
-        ET.SubElement(body, "inertial", pos="0 0 0", mass="1e-6", diaginertia="1e-9 1e-9 1e-9")
-    for i, shape in enumerate(stance_shapes(link)):
-        geom(asset, body, shape, base_dir, f"{link.name}_{i}")
+def _body(scratch: Scratch, parent: ET.Element, link, base_dir: Path, joint) -> ET.Element:
+    """A body placed by `joint` with the link's real inertial and its collision shapes
+    (floor contact only)."""
+    body = scratch.body(parent, link.name, joint.xyz, joint.rpy)
+    scratch.inertial(body, link)
+    scratch.geoms(body, link, stance_shapes(link), base_dir)
     return body
 
 
 def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
-    """The settle model: floor, free base at the floating joint's origin, servos at `home`;
-    links collide with the floor and each other but for joined links and `excluded` pairs
-    (those touching wherever the joints are, which the kit excludes)."""
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
-
+    """The settle model (scratch.py): floor, free base at the floating joint's origin,
+    servos at `home`; links collide with the floor and each other but for joined links and
+    `excluded` pairs (those touching wherever the joints are, which the kit excludes)."""
     floating = robot.floating_joint
-    root = ET.Element("mujoco")
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true", balanceinertia="true")
-    ET.SubElement(root, "option", timestep=repr(TIMESTEP), integrator="implicitfast")
-    ET.SubElement(ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1")
-    asset = ET.SubElement(root, "asset")
-    world = ET.SubElement(root, "worldbody")
-    ET.SubElement(world, "geom", name="floor", type="plane", size="0 0 0.05")
+    scratch = Scratch(
+        compiler={"angle": "radian", "autolimits": "true", "balanceinertia": "true"},
+        geom={"contype": "1", "conaffinity": "1"},
+        option={"timestep": repr(TIMESTEP), "integrator": "implicitfast"},
+    )
+    ET.SubElement(scratch.world, "geom", name="floor", type="plane", size="0 0 0.05")
     base = robot.link(floating.child)
-    quat = _text(quat_wxyz(rpy_matrix(floating.rpy)))
-    bodies = {base.name: _body(world, base, base_dir, asset, pos=_text(floating.xyz), quat=quat)}
+    bodies = {base.name: _body(scratch, scratch.world, base, base_dir, floating)}
     ET.SubElement(bodies[base.name], "freejoint", name=floating.name)
     values = {j.name: q for j, q in zip(robot.movable_joints, home, strict=True)}
     for joint in robot.joints:
         if joint.type == "floating" or joint.parent not in bodies:
             continue
-        quat = _text(quat_wxyz(rpy_matrix(joint.rpy)))
-        body = _body(
-            bodies[joint.parent],
-            robot.link(joint.child),
-            base_dir,
-            asset,
-            pos=_text(joint.xyz),
-            quat=quat,
+        child = robot.link(joint.child)
+        body = bodies[joint.child] = _body(scratch, bodies[joint.parent], child, base_dir, joint)
+        scratch.joint(
+            body,
+            joint,
+            armature=repr(float(joint.armature)),
+            damping=repr(float(joint.damping)),
+            frictionloss=repr(float(joint.friction)),
         )
-        bodies[joint.child] = body
-        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
-        if kind:
-            ET.SubElement(
-                body,
-                "joint",
-                name=joint.name,
-                type=kind,
-                axis=_text(joint.axis),
-                armature=repr(float(joint.armature)),
-                damping=repr(float(joint.damping)),
-                frictionloss=repr(float(joint.friction)),
-            )
-    contact = ET.SubElement(root, "contact")
     pairs = {(j.parent, j.child) for j in robot.joints if j.parent in bodies} | set(excluded)
-    for a, b in sorted(pairs):
-        ET.SubElement(contact, "exclude", body1=a, body2=b)
-    equality = ET.SubElement(root, "equality")
+    scratch.exclude(sorted(pairs))
+    equality = scratch.section("equality")
     for joint in robot.movable_joints:
         if joint.mimic is not None and joint.mimic[0] in values:
             leader, multiplier, offset = joint.mimic
@@ -168,9 +125,9 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
                 "joint",
                 joint1=joint.name,
                 joint2=leader,
-                polycoef=_text([offset, multiplier, 0, 0, 0]),
+                polycoef=text([offset, multiplier, 0, 0, 0]),
             )
-    actuators = ET.SubElement(root, "actuator")
+    actuators = scratch.section("actuator")
     for joint in _servos(robot):
         effort = float(joint.effort_peak)
         ET.SubElement(
@@ -178,11 +135,11 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
             "position",
             name=joint.name,
             joint=joint.name,
-            kp=repr(joint.kp or SERVO_STIFFNESS * effort),  # a softened servo: masses.py
+            kp=repr(joint.kp or SERVO_STIFFNESS * effort),  # a softened servo: rotors.py
             dampratio="1",
-            forcerange=_text([-effort, effort]),
+            forcerange=text([-effort, effort]),
         )
-    return ET.tostring(root, encoding="unicode")
+    return scratch.xml()
 
 
 class Settler:
@@ -191,27 +148,19 @@ class Settler:
     (standing.py's measure)."""
 
     def __init__(self, robot, base_dir: Path, home, follow):
-        import mujoco
-
-        from simkit.importer.collide import always_touching
-        from simkit.importer.stance import Support, stance_shapes
-
         home = np.asarray(home, dtype=float)
         self.robot, self.base_dir, self.follow = robot, base_dir, follow
         self.excluded = always_touching(robot, base_dir, home, follow, stance_shapes)
-        self.model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, home, self.excluded))
-        joint = lambda name: self.model.jnt_qposadr[self.model.joint(name).id]  # noqa: E731
-        self.adr = np.array([joint(j.name) for j in robot.movable_joints], dtype=int)
+        xml = model_xml(robot, base_dir, home, self.excluded)
+        self.model, _data, self.adr = compiled(xml, robot.movable_joints)
         self.servos = _servos(robot)
+        joint = lambda name: self.model.jnt_qposadr[self.model.joint(name).id]  # noqa: E731
         self.servo_adr = np.array([joint(j.name) for j in self.servos], dtype=int)
         self.frame = Support(robot, base_dir).frame
         self.free = self.model.jnt_qposadr[self.model.joint(robot.floating_joint.name).id]
 
     def height(self, q) -> float:
         """m the base's origin stands above the floor at `q`, the base at its rotation."""
-        from simkit.importer.standing import floor_shapes, lowest
-        from simkit.model.kinematics import forward
-
         poses = forward(self.robot, list(q))
         base = poses[self.robot.floating_joint.child][2, 3]
         low = [
@@ -258,15 +207,9 @@ class Settler:
     def candidates(self, home) -> np.ndarray:
         """`home`, then CANDIDATES seeded random poses free of self-contact (stance.py's
         model, the always-touching pairs left out), nearest home first."""
-        import mujoco
-
-        from simkit.importer import stance
-
         robot = self.robot
         movable = robot.movable_joints
-        model = mujoco.MjModel.from_xml_string(stance.model_xml(robot, self.base_dir))
-        data = mujoco.MjData(model)
-        adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+        model, data, adr = compiled(stance.model_xml(robot, self.base_dir), movable)
         lo = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
         hi = np.array([j.upper if j.upper is not None else math.pi for j in movable])
         lo, hi = lo + EDGE * (hi - lo), hi - EDGE * (hi - lo)  # a servo rests off its stops
@@ -297,8 +240,6 @@ def rest_pose(robot, base_dir: Path) -> tuple[list[float], Rest, str] | None:
     hold that rest within LIMIT, else the seeded candidate pose (Settler.candidates) whose
     rest needs the least of any servo's effort; the pose, its rest and one report line.
     None where the robot stands level at home (legs), or no candidate rests within LIMIT."""
-    from simkit.importer.collide import posed
-
     home, follow = posed(robot)
     if robot.floating_joint is None or home is None or not _servos(robot):
         return None

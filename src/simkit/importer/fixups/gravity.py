@@ -26,7 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer import collide
+from simkit.importer.fixups import collide
+from simkit.importer.fixups.scratch import compiled
+from simkit.model.rnea import Tree
 
 #: share of a joint's effort its static gravity load may take at home (kit page: 80 % rule)
 LIMIT = 0.8
@@ -97,16 +99,11 @@ class Search:
     """The pose being searched: loads (Newton-Euler) and self-contact (MuJoCo) of trials."""
 
     def __init__(self, robot, base_dir: Path) -> None:
-        import mujoco
-
-        from simkit.model.rnea import Tree
-
         self.robot = robot
         self.start, self.follow = collide.posed(robot)
         self.movable = self.robot.movable_joints
         self.index = {j.name: i for i, j in enumerate(self.movable)}
         self.tree = Tree.of(self.robot) if self.start is not None else None
-        self.mujoco = mujoco
         self.spec_dir = base_dir
 
     def open(self) -> None:
@@ -114,11 +111,7 @@ class Search:
         closest distance (m) of each pair of links near each other at the start."""
         always = collide.always_touching(self.robot, self.spec_dir, self.start, self.follow)
         xml = collide.model_xml(self.robot, self.spec_dir, always, shapes_of=collide.covered_shapes)
-        self.model = self.mujoco.MjModel.from_xml_string(xml)
-        self.data = self.mujoco.MjData(self.model)
-        self.adr = np.array(
-            [self.model.jnt_qposadr[self.model.joint(j.name).id] for j in self.movable], int
-        )
+        self.model, self.data, self.adr = compiled(xml, self.movable)
         self.near = self._closest(self.start)
 
     def _closest(self, q: np.ndarray) -> dict[tuple[int, int], float]:

@@ -6,13 +6,14 @@ import math
 
 import numpy as np
 
-from simkit.importer.ball_joints import expand as expand_ball_joints
-from simkit.importer.geometry import floats
-from simkit.importer.joints import joint_spec, mimic_limits
-from simkit.importer.links import has_geometry, has_mass, link_spec
-from simkit.importer.meshes import MeshWriter
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.importer.translate.ball_joints import expand as expand_ball_joints
+from simkit.importer.translate.geometry import floats
+from simkit.importer.translate.joints import joint_spec, mimic_limits
+from simkit.importer.translate.links import has_geometry, has_mass, link_spec
+from simkit.importer.translate.meshes import MeshWriter
+from simkit.importer.translate.solids import DENSITY, MAX_SIDE, add_solids
 from simkit.kitio.oneline import one_line
 from simkit.spec.bounds import MAX_BODIES
 from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
@@ -275,8 +276,6 @@ def _visual_collision(source: Source, spec_links: list[dict], report: Report) ->
 def _estimated_solids(source: Source, links: list[dict], joints: list[dict], report) -> None:
     """A floating robot with no geometry at all (a masses-only humanoid) gets an
     estimated box per link with a mass (solids.py), reported on one line."""
-    from simkit.importer.solids import DENSITY, MAX_SIDE, add_solids
-
     done = add_solids(links, joints)
     if done:
         report.estimated(

@@ -9,9 +9,12 @@ legal name and reports it, so that the kit builds; the kit's URDF carries the ne
 from __future__ import annotations
 
 import re
+from types import SimpleNamespace
+from types import SimpleNamespace as NS
 
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.spec.names import MAX_NAME, problems
 
 #: spec keys holding link, joint or frame names: (list key, fields)
 _REFS = {"links": ("name",), "joints": ("name", "parent", "child"), "frames": ("name", "parent")}
@@ -22,8 +25,6 @@ ROUNDS = 8
 def _spelled(name: str) -> str:
     """`name` in the identifier grammar: other characters become `_`, a leading digit gets
     an `n` in front, and it is cut to the length cap."""
-    from simkit.spec.names import MAX_NAME
-
     out = re.sub(r"[^A-Za-z0-9_]", "_", name) or "unnamed"
     out = out if not out[0].isdigit() else f"n{out}"
     return out[: MAX_NAME - 8]
@@ -32,10 +33,6 @@ def _spelled(name: str) -> str:
 def _problems(spec: dict) -> dict[tuple[str, int, str], str]:
     """(list key, index, field) -> why, for each link, joint or frame name (or a frame's
     URDF joint name) the spec refuses."""
-    from types import SimpleNamespace
-
-    from simkit.spec.names import problems
-
     out: dict[tuple[str, int, str], str] = {}
     for loc, why in problems(SimpleNamespace(**_construct(spec))):
         if len(loc) == 3 and loc[0] in _REFS and loc[2] in ("name", "joint"):
@@ -47,8 +44,6 @@ def _problems(spec: dict) -> dict[tuple[str, int, str], str]:
 
 def _construct(spec: dict) -> dict:
     """Just what `spec.names.problems` reads, as plain objects with a `name`."""
-    from types import SimpleNamespace as NS
-
     keys = ("links", "joints", "frames", "materials", "planning_groups")
     out: dict = {
         k: [NS(name=item["name"], joint=item.get("joint")) for item in spec.get(k, [])]

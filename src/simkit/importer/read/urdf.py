@@ -1,94 +1,36 @@
-"""Read a URDF or xacro file and resolve its mesh URIs (package://, file://, relative).
+"""The URDF reader: a `.urdf` file (or a xacro's expansion) parsed into a `Source`.
 
-Errors are one line each, naming the file, the line and the element (`errors.SpecError`).
-Messy but common forms are read leniently, one report line each (`Source.lenient`), and
-refused with `--strict` (docs/importing.md, "Lenient reading"). The report is the one
-diagnostic channel of the read (Drake's DiagnosticPolicy); a PackageMap owns paths.
+The XML is parsed with lxml (no entities, no network); a misplaced declaration and content
+after the root element are read leniently. In a `.urdf`, `$(arg)`, `$(optenv)`, `$(env)`
+and `$(find)` left unexpanded are expanded as xacro would (only names --allow-env gives read
+the environment).
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
-from pathlib import Path
 
 from simkit.errors import SpecError
-from simkit.importer import lenient
-from simkit.importer.lenient import Position
-from simkit.importer.packages import MissingMesh, PackageMap
-from simkit.importer.reading import ReadOptions
-
-__all__ = [
-    "MissingMesh", "Position", "ReadOptions", "Source",
-    "describe", "line_of", "load", "resolve_uri",
-]  # fmt: skip
+from simkit.importer.read import lenient
+from simkit.importer.read.lenient import Position
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.read.source import Source
+from simkit.spec.urdf_blocks import TAGS  # kept verbatim (translate/blocks.py)
 
 
-@dataclass
-class Source:
-    """The parsed document: its root element, where it came from, how to find packages,
-    and the report its lenient readings go to (None: refuse them)."""
-
-    path: Path
-    root: object  # lxml.etree._Element
-    packages: PackageMap
-    report: object | None = None  # importer.report.Report
-
-    def fail(self, element, message: str) -> SpecError:
-        """A one-line error at `element` (file, line, element tag and name)."""
-        return SpecError(str(self.path), line_of(element), describe(element), message)
-
-    def lenient(self, element, message: str) -> None:
-        """A form read the way the field's parsers read it: one report line (changed), or
-        the error `--strict` asks for."""
-        if self.report is None or self.report.strict:
-            raise self.fail(element, f"{message} (--strict refuses it)")
-        self.report.changed(self, element, message)
-
-    def note(self, element, message: str) -> None:
-        """A report line for something the user asked for (a --xacro-arg value used)."""
-        if self.report is not None:
-            self.report.changed(self, element, message)
+def read(shell: Source, options: ReadOptions) -> Source:
+    """`shell` (path and PackageMap, no root yet) with its `.urdf` parsed, leftover
+    substitutions expanded."""
+    document(shell, shell.path.read_bytes())
+    _expand_leftovers(shell, options)
+    return shell
 
 
-def line_of(element) -> int | None:
-    """Source line of an lxml element (None when unknown)."""
-    line = getattr(element, "sourceline", None)
-    return int(line) if line else None
-
-
-def describe(element) -> str:
-    """`tag` or `tag[name]` (URDF elements are named by their `name` attribute)."""
-    if element is None:
-        return "robot"
-    name = element.get("name") if hasattr(element, "get") else None
-    return f"{element.tag}[{name}]" if name else str(element.tag)
-
-
-def load(
-    path: Path,
-    package_dirs: tuple[Path, ...] = (),
-    report=None,
-    options: ReadOptions | None = None,
-) -> Source:
-    """Parse a `.urdf` (or expand a `.xacro`, safely unless trusted); `report` takes the
-    lenient readings (None: they are refused, as with --strict)."""
-    options = options or ReadOptions()
-    if not path.is_file():
-        raise SpecError(str(path), None, "file", "no such file")
-    packages = PackageMap(path, tuple(package_dirs), tuple(options.allow_read))
-    shell = Source(path, None, packages, report)
-    if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro"):
-        from simkit.importer.xacro_safe import expand
-
-        text = expand(path, packages, options, shell)
-    else:
-        text = path.read_bytes()
+def document(shell: Source, text: bytes) -> Source:
+    """`shell` with its root parsed from `text`, which must be a `<robot>`."""
     shell.root = _parse(shell, text)
     if shell.root.tag != "robot":
         raise shell.fail(shell.root, "the root element must be <robot>")
-    if not path.name.endswith(".xacro"):
-        _expand_leftovers(shell, options)
     return shell
 
 
@@ -128,8 +70,6 @@ def _expand_leftovers(source: Source, options: ReadOptions) -> None:
         for e in source.root.iter()
         if isinstance(e.tag, str) and e.tag.rpartition("}")[2] == "arg" and e.get("name")
     }
-    from simkit.spec.urdf_blocks import TAGS  # kept verbatim (importer/blocks.py)
-
     given = options.args()
     core = [e for e in source.root if isinstance(e.tag, str) and e.tag not in TAGS]
     for element in (d for e in core for d in e.iter()):
@@ -178,14 +118,3 @@ def _resolver(source: Source, element, given: dict, defaults: dict, options: Rea
         raise source.fail(element, f"unknown substitution $({command} {' '.join(args)})")
 
     return resolve
-
-
-def resolve_uri(source: Source, element, uri: str) -> Path:
-    """The file a mesh `filename` names (PackageMap); each fallback is one report line.
-    MissingMesh when no file is found, SpecError when refused or ambiguous."""
-    done = len(source.packages.notes)
-    where = (str(source.path), line_of(element), describe(element))
-    path = source.packages.resolve(uri, where)
-    for message in source.packages.notes[done:]:
-        source.note(element, message)
-    return path

@@ -11,14 +11,13 @@ import re
 from pathlib import Path
 
 from simkit.errors import SpecError
-from simkit.importer.source import Source
+from simkit.importer.read.source import Source
+from simkit.spec.validate import load_spec
 
 
 def check(spec_path: Path, spec: dict, source: Source, renames: dict | None = None) -> None:
     """Load `spec_path` through simkit's own validation; a SpecError is re-raised at the URDF
     element its field comes from (`renames`: names.make_legal's URDF -> spec names)."""
-    from simkit.spec.validate import load_spec
-
     try:
         load_spec(spec_path, display=spec_path.name)
     except SpecError as exc:

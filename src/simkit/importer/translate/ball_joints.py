@@ -21,8 +21,10 @@ PyBullet ignores a spherical joint's `<axis>`; so does the import.
 
 from __future__ import annotations
 
-from simkit.importer.geometry import floats
-from simkit.importer.source import Source
+from copy import deepcopy
+
+from simkit.importer.read.source import Source
+from simkit.importer.translate.geometry import floats
 
 KIND = "spherical"
 #: (name suffix, axis, PyBullet `<limit>` attribute holding that axis's half range)
@@ -124,8 +126,6 @@ def _joint(ball, name: str, parent: str, child: str, axis: tuple, ranges) -> obj
 
 def _copy(element):
     """A copy of an element that keeps its source line (for report lines)."""
-    from copy import deepcopy
-
     out = deepcopy(element)
     out.sourceline = element.sourceline
     return out

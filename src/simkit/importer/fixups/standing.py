@@ -13,13 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.kitio.stl import from_stl
+from simkit.model.kinematics import forward, rpy_matrix
+
 
 def points(shape, base_dir: Path) -> np.ndarray:
     """Points bounding one primitive in its link frame (m): mesh vertices, box corners, or the
     corners of a round shape's bounding box."""
-    from simkit.kitio.stl import from_stl
-    from simkit.model.kinematics import rpy_matrix
-
     if shape.kind == "mesh":
         local = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
     else:
@@ -38,8 +38,6 @@ def lowest(shape, pose: np.ndarray, base_dir: Path) -> float:
     """World z (m) of a shape's lowest point with its link at `pose`: exact for round shapes
     (a tilted shin cylinder's bounding-box corners reach below the cylinder: a quadruped with its
     hips spread stood 1.7 cm above the floor), the lowest vertex or corner otherwise."""
-    from simkit.model.kinematics import rpy_matrix
-
     if shape.kind not in ("sphere", "cylinder", "capsule"):
         world = points(shape, base_dir) @ pose[:3, :3].T + pose[:3, 3]
         return float(world[:, 2].min())
@@ -68,8 +66,6 @@ def floor_shapes(link) -> tuple:
 def standing_height(robot, base_dir: Path) -> float | None:
     """Height (m) of the floating base's origin that puts the robot's lowest point at home on
     the floor; None when no link has a solid."""
-    from simkit.model.kinematics import forward
-
     home = dict(robot.poses).get("home")
     poses = forward(robot, home)
     lowest_z = None

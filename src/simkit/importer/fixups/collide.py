@@ -12,43 +12,16 @@ Lengths in m, angles in rad, poses in spec order (`robot.movable_joints`).
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
+from simkit.importer.fixups.scratch import Scratch, compiled, text
 from simkit.model.kinematics import contracted_pairs
 
 #: m: the clearance the chosen pose keeps between non-adjacent links (the kit's collision
 #: pieces are grown a little to cover the visual mesh)
 CLEARANCE = 0.003
-
-
-def text(values) -> str:
-    return " ".join(repr(float(v)) for v in np.ravel(values))
-
-
-def geom(asset, body, shape, base_dir: Path, name: str) -> None:
-    from simkit.kitio.stl import from_stl
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
-
-    attrs = {"pos": text(shape.xyz), "quat": text(quat_wxyz(rpy_matrix(shape.rpy)))}
-    if shape.kind == "mesh":
-        vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
-        ET.SubElement(asset, "mesh", name=name, vertex=text(vertices))
-        attrs.update(type="mesh", mesh=name)
-    elif shape.kind == "box":
-        attrs.update(type="box", size=text(np.asarray(shape.size) / 2))
-    elif shape.kind == "sphere":
-        attrs.update(type="sphere", size=text([shape.radius]))
-    elif shape.kind in ("cylinder", "capsule"):
-        attrs.update(type=shape.kind, size=text([shape.radius, shape.length / 2]))
-    else:  # a cone: its bounding cylinder
-        attrs.update(
-            type="cylinder",
-            size=text([max(shape.radius, shape.radius_top or 0), shape.length / 2]),
-        )
-    ET.SubElement(body, "geom", attrs)
 
 
 def collision_shapes(link) -> tuple:
@@ -73,45 +46,19 @@ def adjacent(robot) -> set[tuple[str, str]]:
     return contracted_pairs(((j.parent, j.child) for j in robot.joints), solid)
 
 
-def add_bodies(root: ET.Element, robot, base_dir: Path, shapes_of, geom) -> None:
-    """The robot's body tree under `root`'s worldbody (unit masses; hinge or slide joints),
-    each link with a geom per shape `shapes_of(link)` gives, written by `geom`: the
-    collision-only MuJoCo model the home (here) and stance (stance.py) searches use."""
-    from simkit.model.kinematics import quat_wxyz, rpy_matrix
-
-    asset = ET.SubElement(root, "asset")
-    bodies = {robot.root: ET.SubElement(root, "worldbody")}
-    for joint in robot.joints:
-        link = robot.link(joint.child)
-        quat = text(quat_wxyz(rpy_matrix(joint.rpy)))
-        body = ET.SubElement(
-            bodies[joint.parent], "body", name=link.name, pos=text(joint.xyz), quat=quat
-        )
-        bodies[link.name] = body
-        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
-        kind = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}.get(joint.type)
-        if kind:
-            ET.SubElement(body, "joint", name=joint.name, type=kind, axis=text(joint.axis))
-        for i, shape in enumerate(shapes_of(link)):
-            geom(asset, body, shape, base_dir, f"{link.name}_{i}")
-
-
 def model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=collision_shapes) -> str:
-    """The search's collision-only MJCF: geoms from `shapes_of(link)` with half the clearance
-    as margin each, joined links and `also_excluded` pairs excluded, no parent filter."""
-
-    root = ET.Element("mujoco")
-    ET.SubElement(root, "compiler", angle="radian")
-    ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable")
+    """The search's collision-only MJCF (scratch.py): geoms from `shapes_of(link)` with half
+    the clearance as margin each, joined links and `also_excluded` pairs excluded, no
+    parent filter."""
     margin = text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
-    ET.SubElement(
-        ET.SubElement(root, "default"), "geom", contype="1", conaffinity="1", margin=margin
+    scratch = Scratch(
+        compiler={"angle": "radian"},
+        geom={"contype": "1", "conaffinity": "1", "margin": margin},
+        flags={"filterparent": "disable"},
     )
-    add_bodies(root, robot, base_dir, shapes_of, geom)
-    contact = ET.SubElement(root, "contact")
-    for a, b in sorted(adjacent(robot) | set(also_excluded)):
-        ET.SubElement(contact, "exclude", body1=a, body2=b)
-    return ET.tostring(root, encoding="unicode")
+    scratch.tree(robot, base_dir, shapes_of)
+    scratch.exclude(sorted(adjacent(robot) | set(also_excluded)))
+    return scratch.xml()
 
 
 def penetration(model, data, adr, q) -> tuple[float, set[tuple[str, str]]]:
@@ -184,12 +131,8 @@ def always_touching(
     excludes such pairs (derive collision_pairs "always", as MoveIt Setup Assistant does), so
     no pose can or need separate them; the search must not try, or it never moves the pair it
     could fix."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_string(model_xml(robot, base_dir, shapes_of=shapes_of))
-    data = mujoco.MjData(model)
     movable = robot.movable_joints
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    model, data, adr = compiled(model_xml(robot, base_dir, shapes_of=shapes_of), movable)
     pairs = contacts(model, data, adr, start)
     rng = np.random.default_rng(robot.seed)
     low = np.array([j.lower if j.lower is not None else -math.pi for j in movable])

@@ -3,7 +3,7 @@
 xacro's module functions are swapped for the duration of one expansion (its state is
 module-global, so expansions are serialised by a lock):
 
-- `safe_eval`: the AST-walking evaluator of importer/safe_eval.py over a symbol table of
+- `safe_eval`: the AST-walking evaluator of importer/read/safe_eval.py over a symbol table of
   math, a few builtins and xacro's own helpers (no `python.vars`, no `python.type`);
 - `eval_extension`: `$(arg)` from --xacro-arg or the xacro's default, `$(find PKG)` through
   the PackageMap, `$(env X)` refused and `$(optenv X D)` giving D unless --allow-env X,
@@ -27,11 +27,13 @@ from pathlib import Path
 from xml.sax.saxutils import escape
 
 from simkit.errors import SpecError
-from simkit.importer import lenient
-from simkit.importer.lenient import Position
-from simkit.importer.packages import PackageMap
-from simkit.importer.reading import ReadOptions
-from simkit.importer.safe_eval import BUILTINS, MATH, MAX_WORK, Evaluator, Refused
+from simkit.importer.read import lenient
+from simkit.importer.read.lenient import Position
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.read.packages import PackageMap
+from simkit.importer.read.safe_eval import BUILTINS, MATH, MAX_WORK, Evaluator, Refused
+from simkit.importer.read.source import Source
+from simkit.importer.read.urdf import document
 
 #: nested macro calls
 MAX_MACRO_DEPTH = 100
@@ -274,3 +276,9 @@ class _Run:
         if self.nodes > MAX_MACRO_NODES:
             raise Limit(f"macros expanded over the limit of {MAX_MACRO_NODES} XML elements")
         return self.original["handle_macro_call"](node, macros, symbols)
+
+
+def read(shell: Source, options: ReadOptions) -> Source:
+    """`shell` (path and PackageMap, no root yet) with its xacro expanded (`expand`) and the
+    expansion parsed as a URDF."""
+    return document(shell, expand(shell.path, shell.packages, options, shell))

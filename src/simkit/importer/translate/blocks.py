@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
 from simkit.spec.urdf_blocks import TAGS, references
 
 

@@ -1,10 +1,17 @@
-"""The spec as YAML: the report as a comment header, then the spec, deterministic."""
+"""Write: the draft's spec as YAML (the report as a comment header, then the spec,
+deterministic), validated once, moved into the output folder with its meshes (output.py), the
+source kept beside it (provenance.py); a refusal names the source element (located.py)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import yaml
+
+from simkit.importer.draft import Draft
+from simkit.importer.write import located, provenance
+from simkit.importer.write.output import publish
+from simkit.kitio.oneline import one_line
 
 
 class _Dumper(yaml.SafeDumper):
@@ -36,8 +43,6 @@ _Dumper.add_representer(dict, _dict)
 
 def spec_yaml(spec: dict, lines: list[str], source: Path) -> str:
     """The spec text: a header naming the source and each report line, then the spec."""
-    from simkit.kitio.oneline import one_line  # a name holding a newline stays a comment
-
     head = [
         f"# Imported from {one_line(source.name)} by `simkit import`. Numbers are the URDF's; "
         "values it",
@@ -48,21 +53,16 @@ def spec_yaml(spec: dict, lines: list[str], source: Path) -> str:
     return "\n".join(head) + "\n" + body
 
 
-def check(path: Path, draft) -> None:
+def check(path: Path, draft: Draft) -> None:
     """Load the written spec through simkit's own validation; a problem is one line at the
-    URDF element its field comes from (importer/located.py), never the staging copy."""
-    from simkit.importer import located
-
+    URDF element its field comes from (write/located.py), never the staging copy."""
     located.check(path, draft.spec, draft.source, draft.renames)
 
 
-def finish(draft, out_dir: Path) -> Path:
+def finish(draft: Draft, out_dir: Path) -> Path:
     """Write the draft's spec once, validate it once (`check`), and copy it with its meshes
     from the staging folder into `out_dir`; a mesh the spec written there before used and
     this one does not is removed (no stale meshes). Returns the spec's path in `out_dir`."""
-    from simkit.importer import provenance
-    from simkit.importer.output import publish
-
     provenance.keep(draft)
     name = draft.spec["name"]
     staged = draft.stage / f"{name}.yaml"
@@ -75,6 +75,16 @@ def finish(draft, out_dir: Path) -> Path:
         (out_dir / old).unlink(missing_ok=True)
     publish(draft.stage, out_dir)  # each file whole (output.py), or one line naming it
     return target
+
+
+def refuse(draft: Draft) -> None:
+    """Raise the draft's first problem where the URDF holds it (located.py): a draft the
+    steps cannot resolve (draft.Unresolvable: a mass of 1e308) stops in one line, not deep
+    in a fix-up."""
+    staged = draft.stage / f"{draft.spec['name']}.yaml"
+    staged.write_text(spec_yaml(draft.spec, draft.report.lines, draft.path), "utf-8")
+    located.check(staged, draft.spec, draft.source, draft.renames)
+    raise RuntimeError("a spec the schema refused passed simkit's validation")
 
 
 def _meshes_of(spec_path: Path) -> set[Path]:

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer import collide
+from simkit.importer.fixups import collide
+from simkit.importer.fixups.scratch import compiled
 
 STEP = {"revolute": math.radians(0.5), "prismatic": 0.001}  # rad, m
 BACK_OFF = 2  # steps kept clear of the first contact (the check sweeps in 2 deg steps)
@@ -30,18 +31,13 @@ DIGITS = 4  # decimals of a narrowed limit, rounded towards home
 def narrowed(robot, base_dir: Path) -> dict[str, tuple[float, float]]:
     """{joint: (lower, upper)} for each joint whose estimated limits were narrowed (rad or
     m), none when home itself is in contact (nothing to measure a free range from)."""
-    import mujoco
-
     start, follow = collide.posed(robot)
     if start is None:
         return {}
     always = collide.always_touching(robot, base_dir, start, follow)
-    model = mujoco.MjModel.from_xml_string(
-        collide.model_xml(robot, base_dir, always, shapes_of=collide.covered_shapes)
-    )
-    data = mujoco.MjData(model)
+    xml = collide.model_xml(robot, base_dir, always, shapes_of=collide.covered_shapes)
     movable = robot.movable_joints
-    adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in movable], dtype=int)
+    model, data, adr = compiled(xml, movable)
     near = _closest(model, data, adr, start)
     if any(d <= 0.0 for d in near.values()):
         return {}

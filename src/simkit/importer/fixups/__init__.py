@@ -1,0 +1,12 @@
+"""Fix-ups: the pose and mass steps an import applies to its draft after translating it.
+
+Each step (steps.py, `STEPS` in order) reads only the draft: its spec and the robot resolved
+from it (`Draft.robot()`), never the source document, save to name the element a report
+record is about. The searches measure the robot on scratch MuJoCo models (scratch.py).
+"""
+
+from __future__ import annotations
+
+from simkit.importer.fixups.steps import SEARCH_LINKS, STEPS
+
+__all__ = ["SEARCH_LINKS", "STEPS"]
