@@ -16,6 +16,7 @@ from pathlib import Path
 from simkit.importer.diagnostics import Report
 from simkit.importer.read.source import Source
 from simkit.model.resolve import resolve
+from simkit.model.robot import Robot
 from simkit.spec.schema import RobotSpec
 
 #: kg/m^3 of an estimated solid: aluminium (`--density` sets another)
@@ -54,7 +55,7 @@ class Draft:
     options: Options
     spec: dict = field(default_factory=dict)
     #: the resolved model of `spec`, or None after a change (resolved again on demand)
-    resolved: object | None = None
+    resolved: Robot | None = None
     #: legs hang from the root (base.decide), whether or not the base floats
     legged: bool = False
     #: the URDF as read, before any rewrite (provenance.as_read): what the kit is compared with
@@ -66,7 +67,7 @@ class Draft:
     #: the source's first element of each (tag, name), built on first use by `where`
     _named: dict | None = field(default=None, repr=False)
 
-    def robot(self):
+    def robot(self) -> Robot:
         """The draft as simkit's model (model/resolve.py): schema-checked, not yet
         validated as a whole (write.finish does that once); `Unresolvable` when the schema
         refuses it."""

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.kitio import interrupt
 from simkit.kitio.stl import from_stl
 from simkit.model.kinematics import quat_wxyz, rpy_matrix
 
@@ -145,8 +146,12 @@ class Scratch:
 
 
 def compiled(xml: str, joints) -> tuple:
-    """(model, data, qpos address of each of `joints`) of a scratch MJCF."""
-    import mujoco
+    """(model, data, qpos address of each of `joints`) of a scratch MJCF. MuJoCo is imported
+    in a held section (kitio/interrupt.py): a signal that arrives while its extension
+    initialises would break that import (an ImportError, not the clean interruption), so it
+    takes effect once the import is done."""
+    with interrupt.held():
+        import mujoco
 
     model = mujoco.MjModel.from_xml_string(xml)
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in joints], dtype=int)
