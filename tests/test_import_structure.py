@@ -4,6 +4,7 @@ and one builder for the scratch MuJoCo models. Small handwritten URDFs."""
 
 from __future__ import annotations
 
+import ast
 import inspect
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from simkit.importer.read.source import Source
 from simkit.model.resolve import resolve
 from simkit.spec.validate import load_spec
 
+FIXUPS = Path(__file__).resolve().parents[1] / "src" / "simkit" / "importer" / "fixups"
 ARM = Path(__file__).resolve().parent / "specs" / "urdf" / "pkg_demo" / "urdf" / "arm.urdf"
 
 
@@ -80,3 +82,19 @@ def test_the_scratch_builder_compiles_the_collision_model(tmp_path):
     assert model.nexclude == len(collide.adjacent(robot)) > 0
     assert model.nbody == len(robot.links) + 1  # the spec's root frame is the world body
     assert data.qpos.shape == (model.nq,)
+
+
+def test_the_fixups_read_only_the_draft():
+    """No fix-up reaches into the source document or another concern's package: the draft
+    (and Draft.where, Draft.note) is all they read and report through."""
+    reached = []
+    for path in sorted(FIXUPS.glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Attribute) and node.attr in ("source", "report"):
+                reached.append(f"{path.name}:{node.lineno}: .{node.attr}")
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                ("simkit.importer.read", "simkit.importer.translate")
+            ):
+                reached.append(f"{path.name}:{node.lineno}: {node.module}")
+    assert len(list(FIXUPS.glob("*.py"))) > 10
+    assert reached == []

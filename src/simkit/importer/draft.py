@@ -94,6 +94,15 @@ class Draft:
         found = element.find(child) if child else None
         return element if found is None else found
 
+    def note(self, message: str, where=None) -> None:
+        """A report record (`estimated`, never refused by --strict) of a value the import
+        chose, at `where` (an element `where()` gave), else the document's root."""
+        self.report.assumed(self.source, self.source.root if where is None else where, message)
+
+    def note_change(self, message: str) -> None:
+        """A report record (`changed`) of the robot kept in another form, at the root."""
+        self.report.changed(self.source, self.source.root, message)
+
     def changed(self) -> None:
         """Forget the resolved model after a change of `spec`."""
         self.resolved = None
@@ -117,11 +126,7 @@ class Draft:
         if found is None:
             return
         self.spec["poses"]["home"], changes = found
-        self.report.assumed(
-            self.source,
-            self.source.root,
-            f"home: {why}; " + ", ".join(changes) + " rad or m",
-        )
+        self.note(f"home: {why}; " + ", ".join(changes) + " rad or m")
         self.changed()
 
     def estimate_base(self, keys: tuple[str, ...], **values: list[float]) -> None:

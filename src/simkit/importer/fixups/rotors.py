@@ -94,5 +94,5 @@ def armature(draft: Draft) -> None:
                 f"that it stays at {SERVO_OMEGA:.0f} rad/s, stable at the kit's 2 ms step"
             )
             spec["estimated"] = [*spec.get("estimated", []), "armature", "kp"]
-        draft.report.assumed(draft.source, where, why)
+        draft.note(why, where)
     draft.changed()

@@ -38,9 +38,7 @@ def searched(draft: Draft, what: str) -> bool:
     links = len(draft.spec["links"])
     if links <= SEARCH_LINKS:
         return True
-    draft.report.assumed(
-        draft.source,
-        draft.source.root,
+    draft.note(
         f"{what} skipped: {links} links, more than the {SEARCH_LINKS} the MuJoCo searches "
         "take (importer/fixups.py SEARCH_LINKS)",
     )
@@ -54,7 +52,7 @@ def base(draft: Draft) -> None:
     turned = upright.upright(draft.robot())
     if turned is not None:
         draft.estimate_base(("rpy",), rpy=[float(f"{v:.6g}") for v in turned[0]])
-        draft.report.assumed(draft.source, draft.source.root, turned[1])
+        draft.note(turned[1])
 
 
 def home(draft: Draft) -> None:
@@ -116,17 +114,13 @@ def stand(draft: Draft) -> None:
     if not draft.floating:  # bolted at the pelvis: raised so that its feet reach the floor
         if height > 0.0:
             draft.estimate_base(("xyz",), xyz=[0.0, 0.0, float(f"{height:.6f}")])
-            draft.report.changed(
-                draft.source,
-                draft.source.root,
+            draft.note_change(
                 f"fixed base bolted {height:.6f} m up: the legs' lowest point at home on the "
                 "floor, as the robot stands",
             )
         return
     draft.estimate_base(("xyz",), xyz=[0.0, 0.0, float(f"{height:.6f}")])
-    draft.report.changed(
-        draft.source,
-        draft.source.root,
+    draft.note_change(
         f"floating base placed {height:.6f} m up: its lowest point at home on the floor",
     )
     _settle(draft)
@@ -155,7 +149,7 @@ def _settle(draft: Draft) -> None:
         xyz=[round(v, 4) + 0.0 for v in rest.xyz],
         rpy=[round(v, 4) + 0.0 for v in rest.rpy],
     )
-    draft.report.assumed(draft.source, draft.source.root, why)
+    draft.note(why)
 
 
 def limits(draft: Draft) -> None:
@@ -170,12 +164,11 @@ def limits(draft: Draft) -> None:
         if joint["name"] in found:
             old = (joint["lower"], joint["upper"])
             joint["lower"], joint["upper"] = found[joint["name"]]
-            draft.report.assumed(
-                draft.source,
-                draft.where("joint", joint["name"]),
+            draft.note(
                 f"estimated limits {old[0]:.4g} .. {old[1]:.4g} narrowed to "
                 f"{joint['lower']:.4g} .. {joint['upper']:.4g}, the range the joint turns "
                 "from home without self-contact",
+                draft.where("joint", joint["name"]),
             )
     draft.changed()
 
