@@ -51,7 +51,7 @@ def as_read(source: Source) -> Source:
 
 def keep(draft) -> None:
     """Write the kept source into the draft's staging folder and add `source` and
-    `source_differences` to its spec (the last step before writer.finish writes it)."""
+    `source_differences` to its spec (the last step before write.finish writes it)."""
     from lxml import etree
 
     original = draft.kept
