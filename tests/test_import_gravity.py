@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer import gravity, import_robot
+from simkit.importer import import_robot
+from simkit.importer.fixups import gravity
 from simkit.model.dynamics import gravity_torques
 from simkit.model.resolve import resolve
 from simkit.spec.validate import load_spec

@@ -71,7 +71,7 @@ def test_always_rule_counts_touching_faces_and_almost_always(tmp_path):
         always_pairs,
         configurations,
     )
-    from simkit.importer import collide
+    from simkit.importer.fixups import collide
 
     robot, _done = _robot(tmp_path, ALWAYS)
     q = configurations(robot, robot.seed, 1000)

@@ -1,4 +1,4 @@
-"""An open mesh is replaced by its convex hull on import (importer/meshes.py). manifold3d
+"""An open mesh is replaced by its convex hull on import (importer/translate/meshes.py). manifold3d
 builds that hull on parallel threads and lists the same triangles in a varying order, so a
 re-import wrote different STL bytes (issue 22's invariant: a re-import is byte-identical).
 The importer now writes the hull's triangles in one canonical order."""
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simkit.importer.meshes import MeshWriter, closed_solid
+from simkit.importer.translate.meshes import MeshWriter, closed_solid
 from simkit.model.robot import canonical_triangles
 
 

@@ -136,7 +136,7 @@ def test_open_mesh_hull_is_a_solid_at_stl_precision():
     """A thin open part (a propeller blade): its hull, written as float32 STL, is closed."""
     import trimesh
 
-    from simkit.importer.meshes import _is_solid, closed_solid
+    from simkit.importer.translate.meshes import _is_solid, closed_solid
 
     rng = np.random.default_rng(3)
     points = rng.random((400, 3)) * (0.25, 0.03, 0.01)
@@ -225,7 +225,7 @@ def test_imported_rigid_quadrotor_rests(tmp_path, kit_factory):
 def test_flying_arm_rests_on_its_frame(tmp_path):
     """A frame with a thin two-link arm hanging below: balanced on the arm's tip it cannot
     rest, so home folds the arm up and the frame carries the weight (the arm's servos do not)."""
-    from simkit.importer.stance import MARGIN, Support
+    from simkit.importer.fixups.stance import MARGIN, Support
     from simkit.model.resolve import resolve
 
     urdf = (

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 from simkit.cli import main
 from simkit.errors import SpecError
 from simkit.importer import import_robot
-from simkit.importer.reading import ReadOptions
+from simkit.importer.read.options import ReadOptions
 
 STL = Path(__file__).resolve().parent / "specs" / "urdf" / "pkg_demo" / "meshes" / "bracket.stl"
 INERTIAL = (

@@ -1,4 +1,4 @@
-"""Estimated position limits are narrowed to the range free of self-contact (importer/limits.py);
+"""Estimated position limits are narrowed to the range free of self-contact (fixups/limits.py);
 published limits are kept. The truth here is geometry by hand: a bar turning over a slab it is
 not joined to (a post between them: joined links never collide in a kit)."""
 

@@ -1,4 +1,4 @@
-"""`importer/meshes.py closed_solid`: a mesh whose triangles are wound every which way but
+"""`importer/translate/meshes.py closed_solid`: a mesh whose triangles are wound every which way but
 close up is rewound and kept ("welded"); a mesh with open edges goes straight to its convex
 hull. The open case skips trimesh's winding walk, a Python loop over the faces that took
 seconds on an industrial arm's CAD meshes and could not close them anyway."""
@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.importer.meshes import closed_solid
+from simkit.importer.translate.meshes import closed_solid
 
 
 def box_with_flipped_faces():

@@ -10,10 +10,11 @@ from pathlib import Path
 import pytest
 
 from simkit.errors import SpecError
-from simkit.importer import import_robot, source
-from simkit.importer.packages import MissingMesh, PackageMap, package_root
-from simkit.importer.reading import ReadOptions
-from simkit.importer.report import Report
+from simkit.importer import import_robot, read
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.read.packages import MissingMesh, PackageMap, package_root
+from simkit.importer.read.source import resolve_uri
 
 STL = Path(__file__).resolve().parent / "specs" / "urdf" / "pkg_demo" / "meshes" / "bracket.stl"
 
@@ -41,9 +42,9 @@ def _write(path: Path, text: str | None = None) -> Path:
 
 def _lines(urdf: Path, **options) -> tuple[str, ...]:
     report = Report()
-    doc = source.load(urdf, (), report, ReadOptions(**options))
+    doc = read.load(urdf, (), report, ReadOptions(**options))
     mesh = doc.root.find("link/visual/geometry/mesh")
-    source.resolve_uri(doc, mesh, mesh.get("filename"))
+    resolve_uri(doc, mesh, mesh.get("filename"))
     return tuple(report.lines)
 
 

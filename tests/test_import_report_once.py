@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
 
 
 def test_the_same_line_is_reported_once(tmp_path):

@@ -1,5 +1,5 @@
 """URDF `spherical` joints (PyBullet's ball joint) imported as three revolute joints about the
-joint frame's x, y, z axes through massless links (importer/ball_joints.py, issue 22)."""
+joint frame's x, y, z axes through massless links (importer/translate/ball_joints.py, issue 22)."""
 
 from __future__ import annotations
 

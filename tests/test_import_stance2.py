@@ -83,7 +83,7 @@ def test_z_up_robot_keeps_its_orientation(tmp_path):
 
 
 def test_estimated_box_holds_the_mass_up_to_its_cap():
-    from simkit.importer.solids import DENSITY, MAX_SIDE, MIN_SIDE, estimated_box
+    from simkit.importer.translate.solids import DENSITY, MAX_SIDE, MIN_SIDE, estimated_box
 
     segment = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, -0.3], [0.0, 0.0, -0.1]])
     light = estimated_box(0.6, segment)  # 0.6 kg over 0.3 m: about 3.6 cm thick
@@ -150,7 +150,7 @@ def test_alike_hip_joints_spread_together(tmp_path):
 def test_alike_groups_need_the_same_limits_and_depth(tmp_path):
     import yaml
 
-    from simkit.importer.alike import groups
+    from simkit.importer.fixups.alike import groups
     from simkit.model.kinematics import forward
     from simkit.model.resolve import resolve
     from simkit.spec.schema import RobotSpec
@@ -173,7 +173,7 @@ def test_lowest_point_of_a_tilted_round_shape_is_exact(kind):
     """A shape tilted 0.7 rad: its lowest point, not its bounding box's corner."""
     from types import SimpleNamespace
 
-    from simkit.importer.standing import lowest, points
+    from simkit.importer.fixups.standing import lowest, points
     from simkit.model.kinematics import rpy_matrix, transform
 
     shape = SimpleNamespace(kind=kind, radius=0.02, length=0.3, xyz=(0.1, 0.0, 0.0),

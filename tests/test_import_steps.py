@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from simkit.importer import import_robot, writer
+from simkit.importer import import_robot
+from simkit.importer import write as writer
 
 URDF = Path(__file__).resolve().parent / "specs" / "urdf"
 ARM = URDF / "pkg_demo" / "urdf" / "arm.urdf"
@@ -143,7 +144,7 @@ def test_legged_robot_bolted_at_the_pelvis_gets_a_home_free_of_contact(tmp_path)
     import mujoco
     import numpy as np
 
-    from simkit.importer import collide
+    from simkit.importer.fixups import collide
     from simkit.model.resolve import resolve
     from simkit.spec.validate import load_spec
 
@@ -230,7 +231,7 @@ def test_estimated_armature_never_swamps_what_the_joint_moves(tmp_path):
     """A 10 g finger on a 10 N m joint: 0.001 x effort would be 0.01 kg m^2, thousands of
     times its own inertia; the armature is held to that inertia and the servo softened so it
     keeps its frequency. A heavy link keeps 0.001 x effort."""
-    from simkit.importer.masses import SERVO_OMEGA
+    from simkit.importer.fixups.rotors import SERVO_OMEGA
 
     body = box("base", "0.1 0.1 0.1", "0 0 0.05", 5.0)
     body += box("upper", "0.05 0.05 0.4", "0 0 0.2", 8.0)

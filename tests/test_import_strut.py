@@ -1,5 +1,5 @@
 """`simkit import --floating-base` (issue 15): a flying arm that leans on its arm starts where
-it rests (importer/settle.py: a short MuJoCo settle, real masses, servos at home), and a
+it rests (importer/fixups/settle.py: a short MuJoCo settle, real masses, servos at home), and a
 robot standing level on its legs keeps its level base. Small handwritten URDFs."""
 
 from __future__ import annotations
@@ -8,8 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer import import_robot, settle
-from simkit.importer.collide import posed
+from simkit.importer import import_robot
+from simkit.importer.fixups import scratch, settle
+from simkit.importer.fixups.collide import posed
 from simkit.spec.validate import load_spec
 
 INERTIA = '<inertia ixx="0.002" iyy="0.002" izz="0.002" ixy="0" ixz="0" iyz="0"/>'
@@ -98,7 +99,7 @@ def test_principal_inertia_of_a_rotated_tensor():
     """The settle model's inertia: the principal moments and the rotation to them, so a
     tensor with products of inertia keeps its moments (kg m^2)."""
     tensor = np.array([[0.02, 0.005, 0.0], [0.005, 0.02, 0.0], [0.0, 0.0, 0.01]])
-    attrs = settle._principal(tensor)
+    attrs = scratch.principal(tensor)
     moments = sorted(float(v) for v in attrs["diaginertia"].split())
     assert np.allclose(moments, [0.01, 0.015, 0.025])
     assert len(attrs["quat"].split()) == 4

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from simkit.importer import import_robot
-from simkit.importer.source import load
-from simkit.importer.up_axis import is_y_up, turn_y_up
+from simkit.importer.read import load
+from simkit.importer.translate.up_axis import is_y_up, turn_y_up
 
 
 def _shank_dae(folder: Path) -> Path:
@@ -77,7 +77,7 @@ def test_meshes_turn_only_where_the_joints_and_inertials_say(tmp_path, tip, turn
 def test_stance_scores_compare_in_order():
     """The stance search's last pass ranks poses by separable contact first, then by all
     contact (pairs its 200 samples call always touching that the kit's 10000 may not)."""
-    from simkit.importer.stance import better
+    from simkit.importer.fixups.stance import better
 
     assert better((-0.0, -0.001), (-0.0, -0.003))
     assert not better((-0.002, 0.0), (-0.0, -0.003))

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from simkit.importer.fixups import SEARCH_LINKS
-from simkit.importer.masses import axis_inertias
+from simkit.importer.fixups.rotors import axis_inertias
 from simkit.model.dynamics import axis_inertia
 from simkit.model.resolve import resolve
 from simkit.spec.validate import load_spec

@@ -116,7 +116,7 @@ def test_build_passes_and_fails_once_the_kept_source_is_changed(tmp_path):
 
 def test_inertia_is_compared_in_link_axes_whatever_frame_the_urdf_gives_it(tmp_path):
     """The source's inertial `rpy` 0 0 pi/2 swaps ixx and iyy in link axes: the kit writes the
-    rotated tensor with rpy 0 (importer/links.py), which is the same body."""
+    rotated tensor with rpy 0 (importer/translate/links.py), which is the same body."""
     tilted = _urdf().replace(
         '<link name="arm"><inertial><mass value="1.0"/>'
         '<inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/>',

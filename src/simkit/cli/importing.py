@@ -73,7 +73,7 @@ def import_urdf(
 ) -> None:
     """Turn a URDF or xacro into OUT/NAME.yaml plus the meshes it needs."""
     from simkit.importer import import_robot
-    from simkit.importer.reading import ReadOptions, parse_xacro_arg
+    from simkit.importer.read.options import ReadOptions, parse_xacro_arg
 
     if floating_base and fixed_base:
         fail(SimkitError("--floating-base and --fixed-base exclude each other"))

@@ -5,11 +5,17 @@ The spec keeps the URDF's numbers exactly; gaps are filled with plausible values
 does not keep is reported too. Output: DIR/NAME.yaml and DIR/meshes/*.stl (relative paths),
 written only when the whole import succeeded.
 
-The import is one in-memory draft (draft.py) passed through explicit, ordered steps:
-`translate` (the URDF to a spec dict: convert.py, names.py, blocks.py), then the pose
-fix-ups (fixups.STEPS: rotors, base, home, stand, limits), then `writer.finish`, which keeps
-the source (provenance.py), writes and validates the spec once, and moves the files into
-place whole (output.py). The staging folder is removed on every way out.
+Sub-packages by concern, each importing only those before it (an import-linter contract,
+docs/architecture.md): `read/` (one reader per format behind one table, to a `Source`),
+`translate/` (the source to the draft's spec), `fixups/` (pose and mass steps that read only
+the draft), `write/` (provenance, the YAML written and validated once, the files moved into
+place). Below them sit `draft.py` (the one typed object every step receives) and
+`diagnostics.py` (the one record and policy every step reports through).
+
+The import reads the file, then passes one draft through `STEPS` in order (translate.to_spec,
+then fixups.STEPS: rotors, base, home, stand, limits), then `write.finish`, which keeps the
+source (write/provenance.py), writes and validates the spec once, and moves the files into
+place whole (write/output.py). The staging folder is removed on every way out.
 """
 
 from __future__ import annotations
@@ -19,9 +25,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from simkit.errors import SpecError
-from simkit.importer.draft import Draft
-from simkit.importer.reading import ReadOptions
-from simkit.importer.report import Report
+from simkit.importer import fixups, read, translate, write
+from simkit.importer.diagnostics import Policy, Report
+from simkit.importer.draft import DENSITY, Draft, Options, Unresolvable
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.write import provenance
+from simkit.importer.write.output import staging
+
+#: the import's steps, in order: each receives the draft and changes it
+STEPS = (translate.to_spec, *fixups.STEPS)
 
 
 @dataclass(frozen=True)
@@ -41,36 +53,6 @@ def robot_name(path: Path) -> str:
     return name if name[0].isalpha() else f"robot_{name}"
 
 
-def translate(draft: Draft, name: str, floating: bool, hull_collision: bool, density: float) -> int:
-    """The URDF to the draft's spec: links, joints, frames and kept blocks, names made legal,
-    `--strict` problems refused, the STEP left out when the meshes are too large. Returns
-    the number of meshes written to the staging folder."""
-    from simkit.importer import blocks, convert, meshes, names
-    from simkit.importer.step_budget import step_fits
-    from simkit.importer.up_axis import turn_y_up
-
-    source, report = draft.source, draft.report
-    mesh_writer = meshes.MeshWriter(draft.stage)
-    mesh_writer.turn_y_up, why = turn_y_up(source)  # Y_UP COLLADA meshes drawn so: turned
-    if why:
-        report.changed(source, source.root, why)
-    spec = convert.convert(source, name, mesh_writer, report, floating, hull_collision, density)
-    renames = names.make_legal(spec, source, report)
-    draft.renames = renames
-    blocks.keep(spec, source, report, blocks.collect(source), renames)
-    if report.strict and report.problems:
-        first = report.problems[0]
-        first.more = len(report.problems) - 1
-        raise SpecError(first.file, first.line, first.field, first.message, first.more)
-    fits, why = step_fits(spec, draft.stage)
-    if not fits:
-        spec["step"] = False
-        report.changed(source, source.root, why)
-    draft.spec = spec
-    draft.changed()
-    return len(mesh_writer.done)
-
-
 def import_robot(
     path: Path,
     out_dir: Path,
@@ -84,28 +66,24 @@ def import_robot(
 ) -> Imported:
     """Import `path` into `out_dir`; SpecError (one line) on input simkit cannot use.
     `floating`: True or False sets the base; None decides it from the robot's structure
-    (base.py; reported). `hull_collision`: links whose URDF collision has meshes collide
+    (translate/base.py; reported). `hull_collision`: links whose URDF collision has meshes collide
     with their visual solid's convex hull instead (one piece; reported per link).
-    `density` (kg/m^3, default masses.DENSITY): a massless link's mass from its solid.
+    `density` (kg/m^3, default draft.DENSITY): a massless link's mass from its solid.
     `reading`: what the reader may do (xacro args, environment, files outside the package;
-    importer/reading.py)."""
-    from simkit.importer import base, fixups, masses, provenance, source, writer
-    from simkit.importer.output import staging
-
+    importer/read/options.py)."""
     name = name or robot_name(path)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
-    report = Report(strict=strict)
-    doc = source.load(path, package_dirs, report, reading)
+    options = Options(name, floating, hull_collision, density or DENSITY)
+    report = Report(Policy(strict=strict))
+    doc = read.load(path, package_dirs, report, reading)
     kept = provenance.as_read(doc)  # before any rewrite (spherical joints)
     with staging(out_dir) as stage:  # removed on every way out, SIGTERM included
-        draft = Draft(doc, path, stage, report, kept=kept)
-        draft.legged, why = base.decide(doc)
-        if floating is None:
-            floating = draft.legged
-            draft.report.assumed(doc, doc.root, why)
-        meshes = translate(draft, name, floating, hull_collision, density or masses.DENSITY)
-        for step in fixups.STEPS:
-            step(draft)
-        spec_path = writer.finish(draft, out_dir)
-    return Imported(spec_path, tuple(draft.report.lines), meshes, len(draft.spec["links"]))
+        draft = Draft(doc, path, stage, report, options, kept=kept)
+        try:
+            for step in STEPS:
+                step(draft)
+        except Unresolvable:
+            write.refuse(draft)
+        spec_path = write.finish(draft, out_dir)
+    return Imported(spec_path, tuple(report.lines), draft.meshes, len(draft.spec["links"]))

@@ -1,10 +1,11 @@
-"""The import in progress: one in-memory spec draft that the import's steps change in turn.
+"""The import in progress: one typed draft that every step of the import receives in turn.
 
-`import_robot` (importer/__init__.py) translates the URDF into a draft, passes it through
-the ordered fix-up steps (importer/fixups.py), and writes and validates it once at the end
-(writer.finish). A step reads the resolved robot (`Draft.robot()`, resolved from the draft
-on first use after a change, never from a file) and records what it changes through the
-draft's methods, each with its report line at the URDF element that caused it.
+`import_robot` (importer/__init__.py) makes a draft of the read source and the user's
+`Options`, passes it through the ordered steps (importer.STEPS: translate.to_spec, then
+fixups.STEPS), and writes and validates it once at the end (write.finish). A step reads the
+resolved robot (`Draft.robot()`, resolved from the draft on first use after a change, never
+from a file) and records what it changes through the draft's methods, each with its report
+record at the source element that caused it.
 """
 
 from __future__ import annotations
@@ -12,54 +13,95 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from simkit.importer.report import Report
-from simkit.importer.source import Source
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.model.resolve import resolve
+from simkit.model.robot import Robot
+from simkit.spec.schema import RobotSpec
+
+#: kg/m^3 of an estimated solid: aluminium (`--density` sets another)
+DENSITY = 2700.0
+
+
+class Unresolvable(Exception):
+    """The draft's spec is one the schema refuses (a mass of 1e308): the import stops, and
+    write.refuse names the source element in one line (the draft cannot: write sits above
+    it in the importer's layers)."""
+
+
+@dataclass(frozen=True)
+class Options:
+    """What the user asked of the import: the spec's `name`; `floating` True or False sets
+    the base, None decides it from the robot's structure (translate/base.py); with
+    `hull_collision`, collision meshes are the visual's convex hull; `density` (kg/m^3) makes
+    a massless link's mass from its solid."""
+
+    name: str
+    floating: bool | None = None
+    hull_collision: bool = False
+    density: float = DENSITY
 
 
 @dataclass
 class Draft:
-    """The spec dict being built, its report, the URDF it comes from (`source`, at `path`)
-    and the staging folder (`stage`) that holds its meshes, against which the spec's
-    relative mesh paths resolve."""
+    """The spec dict being built, its report, the URDF it comes from (`source`, at `path`),
+    the user's `options` and the staging folder (`stage`) that holds its meshes, against
+    which the spec's relative mesh paths resolve."""
 
     source: Source
     path: Path
     stage: Path
     report: Report
+    options: Options
     spec: dict = field(default_factory=dict)
     #: the resolved model of `spec`, or None after a change (resolved again on demand)
-    resolved: object | None = None
+    resolved: Robot | None = None
     #: legs hang from the root (base.decide), whether or not the base floats
     legged: bool = False
     #: the URDF as read, before any rewrite (provenance.as_read): what the kit is compared with
     kept: Source | None = None
     #: names.make_legal's renames, {"links" | "joints" | "frames": {URDF name: spec name}}
     renames: dict = field(default_factory=dict)
+    #: mesh files translate wrote into `stage`
+    meshes: int = 0
+    #: the source's first element of each (tag, name), built on first use by `where`
+    _named: dict | None = field(default=None, repr=False)
 
-    def robot(self):
+    def robot(self) -> Robot:
         """The draft as simkit's model (model/resolve.py): schema-checked, not yet
-        validated as a whole (writer.finish does that once)."""
+        validated as a whole (write.finish does that once); `Unresolvable` when the schema
+        refuses it."""
         if self.resolved is None:
-            from simkit.model.resolve import resolve
-            from simkit.spec.schema import RobotSpec
-
             try:
                 spec = RobotSpec.model_validate(self.spec)
-            except ValueError:  # a pydantic error: one line at the URDF element
-                self._refuse()
+            except ValueError as exc:  # a pydantic error: one line at the URDF element
+                raise Unresolvable(str(exc)) from None
             self.resolved = resolve(spec, b"", f"{self.spec['name']}.yaml")
         return self.resolved
 
-    def _refuse(self) -> None:
-        """Raise the spec's first problem where the URDF holds it (importer/located.py): a
-        draft the fix-ups cannot resolve (a mass of 1e308) stops in one line, not deep in a
-        fix-up."""
-        from simkit.importer import located, writer
+    def where(self, tag: str, name: str, child: str | None = None):
+        """The source element a report record about spec item `name` points at: the first
+        `<tag name=...>` of the source (its `child`, when it has one), else the document's
+        root. The fix-ups locate their records so, without querying the source."""
+        if self._named is None:
+            self._named = {}
+            for element in self.source.root:
+                key = (element.tag, element.get("name"))
+                self._named.setdefault(key, element)
+        element = self._named.get((tag, name))
+        if element is None:
+            return self.source.root
+        found = element.find(child) if child else None
+        return element if found is None else found
 
-        staged = self.stage / f"{self.spec['name']}.yaml"
-        staged.write_text(writer.spec_yaml(self.spec, self.report.lines, self.path), "utf-8")
-        located.check(staged, self.spec, self.source, self.renames)
-        raise RuntimeError("a spec the schema refused passed simkit's validation")
+    def note(self, message: str, where=None) -> None:
+        """A report record (`estimated`, never refused by --strict) of a value the import
+        chose, at `where` (an element `where()` gave), else the document's root."""
+        self.report.assumed(self.source, self.source.root if where is None else where, message)
+
+    def note_change(self, message: str) -> None:
+        """A report record (`changed`) of the robot kept in another form, at the root."""
+        self.report.changed(self.source, self.source.root, message)
 
     def changed(self) -> None:
         """Forget the resolved model after a change of `spec`."""
@@ -84,11 +126,7 @@ class Draft:
         if found is None:
             return
         self.spec["poses"]["home"], changes = found
-        self.report.assumed(
-            self.source,
-            self.source.root,
-            f"home: {why}; " + ", ".join(changes) + " rad or m",
-        )
+        self.note(f"home: {why}; " + ", ".join(changes) + " rad or m")
         self.changed()
 
     def estimate_base(self, keys: tuple[str, ...], **values: list[float]) -> None:

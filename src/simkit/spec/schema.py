@@ -367,7 +367,7 @@ class RobotSpec(Strict):
     #: defaults to `name`.
     asset_dir: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")] | None = None
     #: Write `step/NAME.step`, the STEP assembly (issue 14). `simkit import` sets it false for
-    #: CAD meshes too large for a faceted STEP (importer/step_budget.py); `--no-step` also
+    #: CAD meshes too large for a faceted STEP (importer/translate/step_budget.py); `--no-step` also
     #: leaves it out.
     step: bool = True
     #: Gazebo / ros2_control additions and the free-fall validation (spec_sim.py)

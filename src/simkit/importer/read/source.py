@@ -1,0 +1,59 @@
+"""A read document (`Source`) and its mesh URIs resolved (package://, file://, relative).
+
+Errors are one line each, naming the file, the line and the element (`errors.SpecError`).
+Messy but common forms are read leniently, one report line each (`Source.lenient`), and
+refused with `--strict` (docs/importing.md, "Lenient reading"). The report is the one
+diagnostic channel of the read (Drake's DiagnosticPolicy); a PackageMap owns paths. The
+readers that make a Source, one per format, are in read/__init__.py's table.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from simkit.errors import SpecError
+from simkit.importer.diagnostics import Diagnostic, Report, describe, line_of
+from simkit.importer.read.lenient import Position
+from simkit.importer.read.packages import MissingMesh, PackageMap
+
+__all__ = ["MissingMesh", "Position", "Source", "describe", "line_of", "resolve_uri"]
+
+
+@dataclass
+class Source:
+    """The parsed document: its root element, where it came from, how to find packages,
+    and the report its lenient readings go to (None: refuse them)."""
+
+    path: Path
+    root: object  # lxml.etree._Element
+    packages: PackageMap
+    report: Report | None = None
+
+    def fail(self, element, message: str) -> SpecError:
+        """A one-line error at `element` (file, line, element tag and name): the refusal of
+        an error record."""
+        return Diagnostic.at(self, element, "refused", message, "error").error()
+
+    def lenient(self, element, message: str) -> None:
+        """A form read the way the field's parsers read it: one report line (changed), or
+        the error `--strict` asks for."""
+        if self.report is None:
+            raise self.fail(element, f"{message} (--strict refuses it)")
+        self.report.lenient(self, element, message)
+
+    def note(self, element, message: str) -> None:
+        """A report line for something the user asked for (a --xacro-arg value used)."""
+        if self.report is not None:
+            self.report.changed(self, element, message)
+
+
+def resolve_uri(source: Source, element, uri: str) -> Path:
+    """The file a mesh `filename` names (PackageMap); each fallback is one report line.
+    MissingMesh when no file is found, SpecError when refused or ambiguous."""
+    done = len(source.packages.notes)
+    where = (str(source.path), line_of(element), describe(element))
+    path = source.packages.resolve(uri, where)
+    for message in source.packages.notes[done:]:
+        source.note(element, message)
+    return path

@@ -1,0 +1,193 @@
+"""URDF `<joint>` to a spec joint: type, origin, axis, limits, dynamics, mimic."""
+
+from __future__ import annotations
+
+import math
+
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.importer.translate.geometry import floats, origin, placed
+from simkit.spec.bounds import FIELD_BOUNDS, TURNS
+
+TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating"}
+KNOWN = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
+#: rad/s and m/s given to a joint without a velocity limit
+VELOCITY = {"revolute": 3.0, "continuous": 3.0, "prismatic": 0.5}
+G = 9.81
+
+
+def joint_spec(source: Source, joint, report: Report, load: tuple[float, float]) -> dict:
+    """The spec dict of one joint. `load` = (mass, lever arm in m) of what it carries, for an
+    effort the URDF does not give."""
+    kind = joint.get("type", "")
+    name = joint.get("name")
+    if kind == "planar":
+        raise source.fail(joint, "planar joints are not supported")
+    if kind not in TYPES:
+        raise source.fail(joint, f"unknown joint type '{kind}'")
+    parent, child = joint.find("parent"), joint.find("child")
+    if parent is None or child is None or not parent.get("link") or not child.get("link"):
+        raise source.fail(joint, "a joint needs <parent link=...> and <child link=...>")
+    for element in joint:
+        if isinstance(element.tag, str) and element.tag not in KNOWN:
+            report.dropped(source, element, "not a URDF joint element simkit keeps")
+    xyz, rpy = origin(source, joint)
+    spec: dict = {
+        "name": name,
+        "type": kind,
+        "parent": parent.get("link"),
+        "child": child.get("link"),
+        **placed(xyz, rpy),
+    }
+    if kind in ("fixed", "floating"):
+        return spec
+    axis_el = joint.find("axis")
+    axis = (1.0, 0.0, 0.0) if axis_el is None else floats(source, axis_el, "xyz", 3, "1 0 0")
+    if math.sqrt(sum(a * a for a in axis)) < 1e-9:
+        raise source.fail(axis_el, "joint axis must not be zero")
+    spec["axis"] = list(axis)
+    if kind == "revolute" and _unbounded(joint):
+        kind = spec["type"] = "continuous"
+        report.changed(
+            source,
+            joint.find("limit"),
+            f"revolute limits beyond {TURNS} turns (a placeholder for none, e.g. a rotor): "
+            "imported as continuous",
+        )
+    elif kind == "revolute" and _reversed(joint):
+        kind = spec["type"] = "continuous"
+        source.lenient(
+            joint.find("limit"),
+            "lower > upper, which Bullet reads as no limit: imported as continuous",
+        )
+    estimated: list[str] = []
+    spec.update(_limits(source, joint, kind, report, load, estimated))
+    dynamics = joint.find("dynamics")
+    if dynamics is not None:
+        for key in ("damping", "friction"):
+            value = floats(source, dynamics, key, 1, "0")
+            if value < 0:
+                raise source.fail(dynamics, f"{key} must be >= 0, got {value}")
+            if value:
+                spec[key] = value
+    mimic = joint.find("mimic")
+    if mimic is not None:
+        if not mimic.get("joint"):
+            raise source.fail(mimic, "mimic needs a 'joint'")
+        spec["mimic"] = {
+            "joint": mimic.get("joint"),
+            "multiplier": floats(source, mimic, "multiplier", 1, "1"),
+            "offset": floats(source, mimic, "offset", 1, "0"),
+        }
+        spec["actuated"] = False  # it follows its leader (MJCF equality), no servo of its own
+    if estimated:
+        spec["estimated"] = estimated
+    return spec
+
+
+def _limits(
+    source: Source, joint, kind: str, report: Report, load: tuple[float, float], estimated: list
+) -> dict:
+    limit = joint.find("limit")
+    out: dict = {}
+    element = limit if limit is not None else joint
+    if kind != "continuous":
+        lower = None if limit is None else limit.get("lower")
+        upper = None if limit is None else limit.get("upper")
+        same = lower is not None and upper is not None and _num(lower) == _num(upper)
+        if _reversed(joint):  # a prismatic one (a revolute one became continuous)
+            source.lenient(limit, "lower > upper, which Bullet reads as no limit")
+        if (lower is None and upper is None) or same or _reversed(joint):
+            span = math.pi if kind == "revolute" else 0.1
+            unit = "rad" if kind == "revolute" else "m"
+            why = "lower == upper (no range)" if same else "no position limits"
+            report.estimated(source, element, f"{why}: +-{span:g} {unit}")
+            out["lower"], out["upper"] = -span, span
+            estimated += ["lower", "upper"]
+        else:
+            out["lower"] = floats(source, limit, "lower", 1, "0")
+            out["upper"] = floats(source, limit, "upper", 1, "0")
+            if out["lower"] > out["upper"]:
+                raise source.fail(limit, f"lower ({out['lower']}) is greater than upper")
+    velocity = 0.0 if limit is None else abs(floats(source, limit, "velocity", 1, "0"))
+    if velocity > FIELD_BOUNDS["max_velocity"][1]:  # a placeholder such as 1000: no real limit
+        report.estimated(
+            source, element, f"velocity {velocity:g} is a placeholder: {VELOCITY[kind]:g}"
+        )
+        velocity = 0.0
+        estimated.append("max_velocity")
+    if velocity <= 0:
+        velocity = VELOCITY[kind]
+        if "max_velocity" not in estimated:
+            report.estimated(source, element, f"no velocity limit: {velocity:g}")
+            estimated.append("max_velocity")
+    out["max_velocity"] = velocity
+    effort = 0.0 if limit is None else abs(floats(source, limit, "effort", 1, "0"))
+    if effort > FIELD_BOUNDS["effort_peak"][1]:  # a placeholder: treated as no limit
+        report.estimated(source, element, f"effort {effort:g} is a placeholder")
+        effort = 0.0
+    if effort <= 0:
+        mass, arm = load
+        effort = float(f"{max(1.0, 2.0 * mass * G * (1.0 if kind == 'prismatic' else arm)):.3g}")
+        report.estimated(
+            source,
+            element,
+            f"no effort limit: {effort:g}, twice the static load of what it carries",
+        )
+        estimated.append("effort_peak")
+    out["effort_peak"] = effort
+    return out
+
+
+def _unbounded(joint) -> bool:
+    """A revolute joint whose lower or upper limit lies beyond TURNS turns (a multirotor's
+    rotors give +-1e16): the URDF's way of saying it has none."""
+    limit = joint.find("limit")
+    if limit is None:
+        return False
+    values = [_num(limit.get(key, "0")) for key in ("lower", "upper")]
+    return any(v is not None and abs(v) > TURNS * 2 * math.pi for v in values)
+
+
+def _reversed(joint) -> bool:
+    """A `<limit>` whose lower exceeds its upper (a corpus cube: 1 > -1): Bullet
+    reads it as no limit."""
+    limit = joint.find("limit")
+    if limit is None:
+        return False
+    lower, upper = _num(limit.get("lower", "0")), _num(limit.get("upper", "0"))
+    return lower is not None and upper is not None and lower > upper
+
+
+def _num(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> None:
+    """A mimic follower whose limits do not hold its leader's range mapped through the mimic
+    (a parallel gripper's finger follower: multiplier -1 on a 0..0.548 leader, limits
+    0..0.548) gets that mapped range as its limits, marked estimated and reported: the
+    URDF's limits contradict its own mimic (any opening puts the follower out of range), and
+    the MJCF's equality would fight the follower's limit."""
+    keys = ("lower", "upper")
+    if any(k not in joint or k not in leader for k in keys):
+        return  # continuous (no limits): nothing to contradict
+    m = joint["mimic"]
+    lower, upper = sorted(m["multiplier"] * leader[k] + m["offset"] for k in keys)
+    tol = 1e-9 * max(1.0, abs(lower), abs(upper))
+    if lower >= joint["lower"] - tol and upper <= joint["upper"] + tol:
+        return
+    element = source.root.find(f"joint[@name='{joint['name']}']")
+    report.estimated(
+        source,
+        element if element is not None else source.root,
+        f"limits {joint['lower']:g}..{joint['upper']:g} do not hold the range of its mimic "
+        f"('{m['joint']}' {leader['lower']:g}..{leader['upper']:g} x {m['multiplier']:g} + "
+        f"{m['offset']:g}): {lower:g}..{upper:g}",
+    )
+    joint["lower"], joint["upper"] = lower, upper
+    done = joint.get("estimated", [])
+    joint["estimated"] = [*done, *(k for k in keys if k not in done)]

@@ -1,0 +1,226 @@
+"""URDF `<link>` to a spec link: inertial, geometry, colour and collision choice."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from simkit.importer.diagnostics import Report
+from simkit.importer.read.source import Source
+from simkit.importer.translate import inertia_limit
+from simkit.importer.translate.geometry import floats, origin, shape_of
+from simkit.importer.translate.masses import solid_mass
+from simkit.importer.translate.meshes import MeshWriter
+from simkit.model.kinematics import rpy_matrix
+from simkit.spec.bounds import FIELD_BOUNDS
+from simkit.spec.schema import InertiaSpec
+from simkit.spec.validate import inertia_problem
+
+#: kg and kg m^2 given to a link the URDF leaves massless (MuJoCo needs mass on moving bodies)
+MASSLESS_MASS, MASSLESS_INERTIA = 0.001, 1.0e-7
+#: kg: the smallest mass a spec accepts; a URDF's smaller one is raised to it
+MIN_MASS = FIELD_BOUNDS["mass"][0]
+#: kg/m^3 of the solid sphere whose inertia replaces a zero one
+DENSITY = 1000.0
+KNOWN = {"inertial", "visual", "collision"}
+
+
+def has_mass(link) -> bool:
+    """True when the link's `<inertial>` gives a positive mass."""
+    mass = link.find("inertial/mass")
+    try:
+        return mass is not None and float(mass.get("value", "0")) > 0
+    except ValueError:
+        return False
+
+
+def has_geometry(link) -> bool:
+    return link.find("visual") is not None or link.find("collision") is not None
+
+
+def _rotated(tensor: np.ndarray, rpy) -> np.ndarray:
+    rot = rpy_matrix(rpy)
+    return rot @ tensor @ rot.T
+
+
+def inertial(source: Source, link, report: Report) -> dict:
+    """mass, com, inertia (about the CoM, link axes) and the estimates and decision made."""
+    element = link.find("inertial")
+    if not has_mass(link):
+        report.estimated(
+            source,
+            link,
+            f"no positive mass in the URDF: {MASSLESS_MASS} kg, inertia {MASSLESS_INERTIA} kg m^2",
+        )
+        i = MASSLESS_INERTIA
+        return {
+            "mass": MASSLESS_MASS,
+            "com": [0.0, 0.0, 0.0],
+            "inertia": {"ixx": i, "iyy": i, "izz": i},
+            "estimated": ["mass", "com", "inertia"],
+            "note": "massless in the URDF; a small mass keeps MuJoCo's moving bodies valid",
+        }
+    mass = floats(source, element.find("mass"), "value", 1)
+    xyz, rpy = origin(source, element)
+    tag = element.find("inertia")
+    if tag is None:
+        values = (0.0,) * 6
+    else:
+        values = tuple(
+            floats(source, tag, k, 1, "0") for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        )
+    ixx, iyy, izz, ixy, ixz, iyz = values
+    tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    if any(rpy):
+        tensor = _rotated(tensor, rpy)
+    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
+    out: dict = {"mass": mass, "com": list(xyz)}
+    if mass < MIN_MASS:  # a placeholder mass (1e-6 kg) is below what the spec accepts
+        tensor, mass = tensor * (MIN_MASS / mass), MIN_MASS
+        flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
+        report.estimated(
+            source,
+            element.find("mass"),
+            f"mass {out['mass']:g} kg is too small to simulate: {MIN_MASS:g} kg, inertia "
+            "scaled by the same factor (same radius of gyration)",
+        )
+        out.update(mass=mass, estimated=["mass", "inertia"])
+    if np.trace(tensor) <= 1e-12 * max(mass, 1e-12):
+        radius = (3 * mass / (4 * math.pi * DENSITY)) ** (1 / 3)
+        moment = 0.4 * mass * radius * radius
+        report.estimated(
+            source,
+            tag if tag is not None else element,
+            f"zero inertia: a {DENSITY:g} kg/m^3 solid sphere of that mass ({moment:.3g} kg m^2)",
+        )
+        out["inertia"] = {"ixx": moment, "iyy": moment, "izz": moment}
+        out["estimated"] = sorted({*out.get("estimated", []), "inertia"})
+        return out
+    out["inertia"] = {k: float(round(v, 15)) for k, v in zip(keys, flat, strict=True)}
+    inertia_limit.nudge(source, tag, out, report)  # a flat plate MuJoCo would refuse
+    problem = inertia_problem(InertiaSpec(**out["inertia"]))
+    if problem:
+        report.estimated(source, tag, f"{problem}: balanced (inertia_decision)")
+        out["inertia_decision"] = {
+            "action": "balance",
+            "reason": f"the URDF's inertia is not physical ({problem}); imported as given, "
+            "the kit carries the balanced tensor",
+        }
+    return out
+
+
+def _colour(source: Source, visual, materials: dict[str, tuple]) -> tuple | None:
+    element = visual.find("material")
+    if element is None:
+        return None
+    colour = element.find("color")
+    if colour is not None:
+        return floats(source, colour, "rgba", 4)
+    return materials.get(element.get("name", ""))
+
+
+def link_spec(
+    source: Source,
+    link,
+    writer: MeshWriter,
+    report: Report,
+    materials: dict[str, tuple],
+    colours: dict[tuple, str],
+    hull_collision: bool = False,
+    density: float | None = None,
+) -> dict:
+    """The spec dict of one link. `colours` maps rgba -> material name (filled here).
+    `density` (kg/m^3): a massless link gets the mass of its solid at it (masses.py)."""
+    name = link.get("name")
+    spec: dict = {"name": name}
+    if has_mass(link) or density is None:
+        spec.update(inertial(source, link, report))
+    for child in link:
+        if isinstance(child.tag, str) and child.tag not in KNOWN:
+            report.dropped(source, child, "not a URDF link element simkit keeps")
+    visuals, rgba = [], None
+    for visual in link.findall("visual"):
+        got = shape_of(source, visual, writer, report, "visual")
+        if got is None:
+            continue
+        shape, info = got
+        visuals.append(shape)
+        if info is not None and info.repair == "hull":
+            report.changed(source, visual, f"{shape['file']}: open mesh, its convex hull is used")
+        colour = _colour(source, visual, materials) or (info.rgba if info else None)
+        if colour is not None and rgba is not None and tuple(map(float, colour)) != rgba:
+            report.changed(  # a kit link is one solid with one material
+                source,
+                visual,
+                f"colour {' '.join(f'{c:g}' for c in colour)}: the link's solid takes its "
+                f"first visual's colour, {' '.join(f'{c:g}' for c in rgba)}",
+            )
+        if rgba is None and colour is not None:
+            rgba = tuple(float(c) for c in colour)
+    collisions, infos = [], []
+    for element in link.findall("collision"):
+        got = shape_of(source, element, writer, report, "collision")
+        if got is not None:
+            collisions.append(got[0])
+            infos.append(got[1])
+    solid = visuals
+    if not visuals and collisions:
+        solid = collisions
+        report.changed(source, link, "no visual: the collision geometry is the visual solid")
+    used = {s["file"] for s in solid if s["shape"] == "mesh"}
+    if any(i.file in used and i.repair == "hull" for i in writer.done.values()):
+        spec["estimated"] = [*spec.get("estimated", []), "solid"]
+    if "mass" not in spec:  # massless, its mass estimated from the solid
+        spec.update(_from_solid(source, link, report, solid, writer, density))
+    if solid:
+        spec["solid"] = solid
+    if rgba is not None:
+        colours.setdefault(rgba, f"colour_{len(colours)}")
+        spec["material"] = colours[rgba]
+    chosen = _collision(collisions, infos)
+    if hull_collision and chosen["collision"] in ("given", "auto"):
+        chosen = {"collision": "mesh"}
+        report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
+    spec.update(chosen)
+    return spec
+
+
+def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dict:
+    """A massless link's mass, CoM and inertia: its visual solid's at `density` (kg/m^3),
+    estimated and reported; the placeholder speck (`inertial`) where it has no volume."""
+    found = solid_mass(solid, writer.out_dir, density) if solid else None
+    if found is None or found[0] < MIN_MASS:
+        return inertial(source, link, report)
+    mass, com, tensor, volume, what = found
+    report.estimated(
+        source,
+        link,
+        f"no mass in the URDF: {mass:.4g} kg, its visual solid's volume ({volume:.4g} m^3, "
+        f"{what}) at {density:g} kg/m^3 (--density); CoM and inertia of that solid",
+    )
+    flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
+    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    return {
+        "mass": float(f"{mass:.6g}"),
+        "com": [float(f"{c:.6g}") + 0.0 for c in com],
+        "inertia": {k: float(f"{v:.9g}") + 0.0 for k, v in zip(keys, flat, strict=True)},
+        "estimated": ["mass", "com", "inertia"],
+        "note": f"massless in the URDF; mass of its visual solid at {density:g} kg/m^3",
+    }
+
+
+#: up to this many collision elements are kept as the link's pieces (one convex hull each)
+MAX_GIVEN = 10
+PRIMITIVES = {"box", "cylinder", "sphere", "capsule"}
+
+
+def _collision(collisions: list[dict], infos: list) -> dict:
+    """Primitives stay primitives; up to MAX_GIVEN meshes are kept, one convex piece each
+    (`given`); more go to the cached CoACD path (`auto`); none means no collision geometry."""
+    if all(c["shape"] in PRIMITIVES for c in collisions):
+        return {"collision": "primitives", "collision_primitives": collisions}
+    if len(collisions) <= MAX_GIVEN:
+        return {"collision": "given", "collision_shapes": collisions}
+    return {"collision": "auto"}
