@@ -19,7 +19,7 @@ import mujoco
 import pytest
 import trimesh
 
-from simkit.derive.gpu_scene import MAX_HULL_VERTICES
+from simkit.derive.gpu_colliders import MAX_HULL_VERTICES
 from simkit.importer import import_robot
 from simkit.pipeline import build
 
