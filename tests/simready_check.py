@@ -103,6 +103,7 @@ def prefer_core_tier() -> None:
     the newer release and reads local folders, while the Isaac tier's alpha lists folders and
     finds thumbnails only through Omniverse's omni.client (not on PyPI). Re-importing a
     module runs its registrations again, and the last registration wins."""
+    register_physx_schema()
     import usd_validation_nvidia  # noqa: F401  (loads both tiers' plugins first)
 
     for name in CORE_FIRST:

@@ -257,6 +257,12 @@ def _open(kit: Kit):
         stage = Usd.Stage.Open(str(path), Usd.Stage.LoadAll)
     except Exception as exc:  # pxr raises Tf.ErrorException with the parser's message
         return None, path, [require("usd.open", False, f"{rel}: {exc}")]
+    broken = [
+        " ".join(str(e).replace(f"{path.parent}/", "").split())[:240]
+        for e in stage.GetCompositionErrors()
+    ]
+    if broken:  # a layer that does not open or parse, an arc to nothing
+        return stage, path, [require("usd.open", False, f"{rel}: {'; '.join(broken[:3])}")]
     errors, warns = validate(stage)
     top = stage.GetDefaultPrim()
     meta = (
@@ -291,7 +297,7 @@ def check_usd(kit: Kit) -> list[Finding]:
     for the others; the "none" variant must hold no physics)."""
     stage, path, findings = _open(kit)
     top = stage.GetDefaultPrim() if stage is not None else None
-    if not top:
+    if not top or not all(f.ok for f in findings if f.check == "usd.open"):
         return findings
     findings += layer_findings(stage) + normals_findings(stage) + thumbnail_findings(path)
     variants = top.GetVariantSet(VARIANT_SET)
