@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import importlib
 import json
+import subprocess
 import sys
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import tomllib
@@ -168,9 +169,26 @@ def requirement_ids(features: list[tuple[str, str]]) -> list[str]:
 
 
 def validate(asset: Path, requirements: list[str]) -> list[Problem]:
-    """Failures and errors of the requirements on the asset (a file), sorted."""
+    """Failures and errors of the requirements on the asset (a file), sorted. Runs in a fresh
+    Python: schema plugins (PhysX, Isaac's robot schema) must register before pxr first reads
+    its schema registry, which an earlier test in the same process has done."""
+    proc = subprocess.run(
+        [sys.executable, __file__, str(asset), *requirements],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    if proc.returncode != 0:
+        raise RuntimeError(f"the SimReady validation did not run: {proc.stderr.strip()[-2000:]}")
+    rows = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
+    return [Problem(**row) for row in rows]
+
+
+def _validate_here(asset: Path, requirements: list[str]) -> list[Problem]:
     register_physx_schema()
     prefer_core_tier()
+    import usd.schema.isaac  # noqa: F401  (registers IsaacRobotAPI before any stage opens)
     from usd_validation_nvidia import IssueSeverity, RequirementsRegistry, ValidationEngine
 
     registry = RequirementsRegistry()
@@ -180,9 +198,8 @@ def validate(asset: Path, requirements: list[str]) -> list[Problem]:
         if req is None:
             raise KeyError(f"requirement {code} is registered by no installed validator")
         engine.enable_requirement(req)
-    results = engine.validate(str(asset))
     out = []
-    for issue in results.issues():
+    for issue in engine.validate(str(asset)).issues():
         if issue.severity not in (IssueSeverity.FAILURE, IssueSeverity.ERROR):
             continue
         at = issue.at
@@ -197,3 +214,8 @@ def validate(asset: Path, requirements: list[str]) -> list[Problem]:
             )
         )
     return sorted(out, key=lambda p: (p.requirement, p.at, p.message))
+
+
+if __name__ == "__main__":
+    for problem in _validate_here(Path(sys.argv[1]), sys.argv[2:]):
+        print(json.dumps(asdict(problem)))

@@ -7,7 +7,7 @@ and the mesh meet."""
 from __future__ import annotations
 
 from simkit.emit.usd.common import collision_pieces, export, new_stage, place, prim_name, reference
-from simkit.emit.usd.geometry import INSTANCES, LOOKS
+from simkit.emit.usd.geometry import INSTANCES, LOOKS, link_material, looks
 from simkit.model.kinematics import forward, rpy_matrix
 from simkit.model.robot import Robot
 
@@ -30,8 +30,7 @@ def base_text(robot: Robot) -> str:
     Usd.ModelAPI(top).SetKind(Kind.Tokens.component)
     arcs: list[tuple[str, str, str]] = []
     _frames(stage, f"/{root}", robot, robot.root)
-    materials = {name for name, _rgba in robot.materials}
-    if materials:
+    if looks(robot):
         stage.DefinePrim(f"/{root}/{LOOKS}", "Scope")
         arcs.append((f"/{root}/{LOOKS}", "./materials.usda", ""))
     poses = forward(robot)
@@ -43,11 +42,10 @@ def base_text(robot: Robot) -> str:
         if link.solid is not None:
             UsdGeom.Xform.Define(stage, f"{base}/visuals")
             arcs.append((f"{base}/visuals", "./instances.usda", f"/{INSTANCES}/{name}/visuals"))
-            if link.material in materials:
-                over = stage.OverridePrim(f"{base}/visuals/{name}")
-                UsdShade.MaterialBindingAPI.Apply(over)
-                rel = over.CreateRelationship(UsdShade.Tokens.materialBinding, custom=False)
-                rel.SetTargets([f"/{root}/{LOOKS}/{prim_name(link.material)}"])
+            over = stage.OverridePrim(f"{base}/visuals/{name}")
+            UsdShade.MaterialBindingAPI.Apply(over)
+            rel = over.CreateRelationship(UsdShade.Tokens.materialBinding, custom=False)
+            rel.SetTargets([f"/{root}/{LOOKS}/{prim_name(link_material(robot, link))}"])
         if collision_pieces(link)[0] != "none":
             UsdGeom.Scope.Define(stage, f"{base}/collisions")
             target = f"/{INSTANCES}/{name}/collisions"

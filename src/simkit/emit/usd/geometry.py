@@ -42,12 +42,33 @@ def geometries_text(robot: Robot) -> str:
     return export(layer)
 
 
+#: the material of a drawn link whose spec gives none (its colour: `Robot.material_rgba`)
+UNASSIGNED = "unassigned"
+
+
+def link_material(robot: Robot, link) -> str:
+    """The material a link's visual mesh is bound to (every drawn mesh has one: SimReady
+    VM.MAT.001)."""
+    known = {name for name, _rgba in robot.materials}
+    return link.material if link.material in known else UNASSIGNED
+
+
+def looks(robot: Robot) -> list[tuple[str, tuple]]:
+    """(material, RGBA) for `materials.usda`: the spec's colours, then UNASSIGNED if a drawn
+    link needs it."""
+    out = list(robot.materials)
+    drawn = [link for link in robot.links if link.solid is not None]
+    if any(link_material(robot, link) == UNASSIGNED for link in drawn):
+        out.append((UNASSIGNED, robot.material_rgba(None)))
+    return out
+
+
 def materials_text(robot: Robot) -> str:
     """`/Looks/MATERIAL`: one UsdPreviewSurface material per spec colour."""
     from pxr import Gf, Sdf, UsdShade
 
     layer, stage, _top = new_stage(robot, LOOKS, "Scope")
-    for name, rgba in robot.materials:
+    for name, rgba in looks(robot):
         path = f"/{LOOKS}/{prim_name(name)}"
         material = UsdShade.Material.Define(stage, path)
         shader = UsdShade.Shader.Define(stage, f"{path}/PreviewSurface")

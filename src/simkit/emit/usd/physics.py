@@ -29,6 +29,7 @@ from simkit.emit.usd.common import (
     quatf,
     r,
 )
+from simkit.emit.usd.mimic import apply_mimic
 from simkit.emit.usd.robot_schema import apply_robot_schema
 from simkit.kitio.fmt import rounded
 from simkit.model.inertia import principal_axes
@@ -107,6 +108,8 @@ def _joint(stage, root: str, robot: Robot, joint: Joint, anchor: Joint | None) -
     if joint.movable:
         schema.CreateAxisAttr(token)
         _limits_and_drive(schema, robot, joint)
+    if joint.mimic is not None:
+        apply_mimic(schema.GetPrim(), robot, joint)
     return path
 
 

@@ -20,11 +20,13 @@ def physx_text(robot: Robot) -> str:
     name = prim_name(robot.name)
     layer, stage, _top = new_stage(robot, name, over=True)
     for joint in robot.joints:
-        if not joint.movable or not (joint.armature or joint.max_velocity):
+        if not joint.movable:
             continue
+        if not (joint.armature or joint.max_velocity):
+            continue
+        prim = stage.OverridePrim(f"/{name}/joints/{prim_name(joint.name)}")
         angular = joint.type != "prismatic"
         kind = "angular" if angular else "linear"
-        prim = stage.OverridePrim(f"/{name}/joints/{prim_name(joint.name)}")
         prim.AddAppliedSchema(f"PhysxJointAxisAPI:{kind}")
         values = {"armature": joint.armature}
         if joint.max_velocity:
