@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit import __version__
 from simkit.emit.ros2 import DEFAULT_MAINTAINER, default_license
 from simkit.emit.usd.common import export, new_stage, prim_name, r
 from simkit.kitio.fmt import rounded
@@ -62,12 +61,9 @@ def metadata(robot: Robot) -> dict:
             "asset_extents": Gf.Vec3f(*extents(robot)),
             "mass": rounded(robot.total_mass),
         },
-        "simkit": {
-            "generator": "simkit",
-            "simkit_version": __version__,
-            "spec": robot.spec_file,
-            "spec_sha256": robot.spec_sha256,
-        },
+        # who made the asset from what; versions and the spec's hash are robot.json's
+        # provenance, so that a rebuild by a newer simkit changes no USD file
+        "simkit": {"generator": "simkit", "spec": robot.spec_file},
     }
 
 

@@ -1,9 +1,10 @@
 """The USD thumbnail (`usd/.thumbs/256x256/NAME.usda.png`, where Omniverse and the SimReady
 rules RC.004 and SR.002 look): the robot's visual solids in the home pose, in the spec's
-colours, drawn by this module. A software painter's render (faces far to near, Lambert shading,
-drawn at twice the size and averaged down) and not MuJoCo's offscreen render: an emitter reads
-no OpenGL driver, so the same spec gives the same PNG bytes on every machine, and a machine
-without EGL or OSMesa still builds the kit."""
+colours, drawn by this module. A software render (a z-buffer over the solids' triangles,
+Lambert shading, drawn at twice the size and averaged down) and not MuJoCo's offscreen render:
+an emitter reads no OpenGL driver, so the same spec gives the same PNG bytes on every machine,
+a machine without EGL or OSMesa still builds the kit, and a solid cut into other triangles
+(round-off in a spec) draws the same pixels."""
 
 from __future__ import annotations
 
@@ -49,12 +50,67 @@ def _triangles(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(tris), np.concatenate(rgb)
 
 
+#: a triangle whose pixel box is at most TILE x TILE is rasterised with others in one array
+TILE = 8
+CHUNK = 20000  # triangles per array (memory: CHUNK x TILE^2 samples)
+
+
+def _samples(xy: np.ndarray, depth: np.ndarray, first: int, tile: int):
+    """(pixel x, pixel y, depth, triangle) of the pixel centres inside each triangle, from a
+    tile x tile grid at the corner of its box (xy: (N, 3, 2) pixels; depth: (N, 3))."""
+    lo = np.floor(xy.min(axis=1)).astype(np.int64)
+    grid = np.stack(np.meshgrid(np.arange(tile), np.arange(tile), indexing="ij"), -1)
+    px = lo[:, None, :] + grid.reshape(1, -1, 2)
+    centre = px + 0.5
+    a, b, c = xy[:, 0, None], xy[:, 1, None], xy[:, 2, None]
+
+    def edge(p, q, r):
+        return (q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - (q[..., 1] - p[..., 1]) * (
+            r[..., 0] - p[..., 0]
+        )
+
+    area = edge(a, b, c)
+    w0, w1, w2 = edge(b, c, centre), edge(c, a, centre), edge(a, b, centre)
+    sign = np.where(area < 0, -1.0, 1.0)
+    inside = (w0 * sign >= 0) & (w1 * sign >= 0) & (w2 * sign >= 0) & (np.abs(area) > 1e-12)
+    safe = np.where(np.abs(area) > 1e-12, area, 1.0)
+    z = (w0 * depth[:, 0, None] + w1 * depth[:, 1, None] + w2 * depth[:, 2, None]) / safe
+    tri = np.broadcast_to(np.arange(first, first + len(xy))[:, None], inside.shape)
+    return px[inside][:, 0], px[inside][:, 1], z[inside], tri[inside]
+
+
+def _rasterise(xy: np.ndarray, depth: np.ndarray, size: int) -> np.ndarray:
+    """The nearest triangle per pixel (-1: none), a z-buffer: the picture does not depend on
+    the order of the triangles, so the same surface cut into other triangles draws the same."""
+    span = np.ceil(xy.max(axis=1)) - np.floor(xy.min(axis=1))
+    small = np.flatnonzero((span <= TILE).all(axis=1))
+    parts = []
+    for start in range(0, len(small), CHUNK):
+        pick = small[start : start + CHUNK]
+        x, y, z, tri = _samples(xy[pick], depth[pick], 0, TILE)
+        parts.append((x, y, z, pick[tri]))
+    for i in np.flatnonzero(~(span <= TILE).all(axis=1)):
+        tile = int(span[i].max()) + 1
+        parts.append(_samples(xy[i : i + 1], depth[i : i + 1], int(i), tile))
+    x, y, z, tri = (np.concatenate(v) for v in zip(*parts, strict=True))
+    keep = (x >= 0) & (y >= 0) & (x < size) & (y < size)
+    pixel, z, tri = (y * size + x)[keep], z[keep], tri[keep]
+    order = np.lexsort((tri, z, pixel))  # per pixel: nearest, then lowest triangle index
+    pixel, tri = pixel[order], tri[order]
+    first = np.ones(len(pixel), dtype=bool)
+    first[1:] = pixel[1:] != pixel[:-1]
+    out = np.full(size * size, -1, dtype=np.int64)
+    out[pixel[first]] = tri[first]
+    return out.reshape(size, size)
+
+
 def thumbnail_pixels(robot: Robot) -> np.ndarray:
     """(SIZE, SIZE, 3) uint8 RGB."""
-    from PIL import Image, ImageDraw
+    from PIL import Image
 
     big = SIZE * SUPER
-    image = Image.new("RGB", (big, big), BACKGROUND)
+    canvas = np.empty((big, big, 3), dtype=np.uint8)
+    canvas[:] = BACKGROUND
     tris, rgb = _triangles(robot)
     if len(tris):
         right, up, view = _camera()
@@ -65,16 +121,15 @@ def thumbnail_pixels(robot: Robot) -> np.ndarray:
         light = -view + np.array([0.0, 0.0, 0.6])
         light /= np.linalg.norm(light)
         shade = AMBIENT + (1 - AMBIENT) * np.clip(normals @ light, 0.0, 1.0)
-        colours = np.clip(rgb * shade[:, None] * 255.0, 0, 255).round().astype(int)
+        colours = np.clip(rgb * shade[:, None] * 255.0, 0, 255).round().astype(np.uint8)
         xy = np.stack([tris @ right, -(tris @ up)], axis=-1)  # image y runs down
         lo, hi = xy.reshape(-1, 2).min(axis=0), xy.reshape(-1, 2).max(axis=0)
         scale = 0.9 * big / max(float((hi - lo).max()), 1e-9)
         xy = np.round((xy - (lo + hi) / 2) * scale + big / 2, 3)
-        order = np.argsort(-(tris @ view).mean(axis=1), kind="stable")  # far to near
-        draw = ImageDraw.Draw(image)
-        for i in order:
-            draw.polygon([tuple(p) for p in xy[i]], fill=tuple(colours[i]))
-    small = image.resize((SIZE, SIZE), Image.Resampling.BOX)
+        nearest = _rasterise(xy, np.round(tris @ view, 9), big)
+        drawn = nearest >= 0
+        canvas[drawn] = colours[nearest[drawn]]
+    small = Image.fromarray(canvas, "RGB").resize((SIZE, SIZE), Image.Resampling.BOX)
     return np.asarray(small, dtype=np.uint8)
 
 
