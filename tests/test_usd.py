@@ -95,8 +95,8 @@ def test_stage_layout(rosie_1000):
     assert len(normals) == len(visual.GetFaceVertexIndicesAttr().Get())
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
-    layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix in (".usd", ".usda")]
-    assert len(layers) == 7
+    layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix == ".usda"]
+    assert len(layers) == 6  # and the binary geometries.usd
     for path in sorted(layers):
         text = path.read_text(encoding="utf-8")
         assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
@@ -145,7 +145,6 @@ def test_rebuild_is_byte_identical(rosie_1000):
             "payload = @./payloads/physx.usda@",
             "usd.physics.bodies",
         ),
-        ("usd/payloads/geometries.usd", "primvars:normals", "primvars:unused", "usd.normals"),
         ("usd/payloads/base.usda", 'upAxis = "Z"', 'upAxis = "Y"', "usd.layers"),
     ],
 )
@@ -348,3 +347,22 @@ def test_broken_payload_layer_fails(rosie_1000, tmp_path):
     shutil.copytree(rosie_1000.kit_dir, kit)
     (kit / PHYSICS).write_text("#usda 1.0\ndef Xform {\n", encoding="utf-8")
     assert [f.check for f in check_usd(Kit.open(kit)) if not f.ok] == ["usd.open"]
+
+
+def drop_normals(path: Path, mesh: str) -> None:
+    """Remove one mesh's normals from a layer (the geometry is a binary crate)."""
+    from pxr import Sdf
+
+    layer = Sdf.Layer.FindOrOpen(str(path))
+    spec = layer.GetPrimAtPath(mesh)
+    spec.RemoveProperty(spec.properties["primvars:normals"])
+    layer.Save()
+
+
+def test_a_mesh_without_normals_fails(rosie_1000, tmp_path):
+    kit = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, kit)
+    drop_normals(kit / "usd/payloads/geometries.usd", "/geometries/link_2/collision_00")
+    failed = [f for f in check_usd(Kit.open(kit)) if not f.ok]
+    assert [f.check for f in failed] == ["usd.normals"]
+    assert "/rosie_1000/link_2/collisions/collision_00" in failed[0].detail

@@ -21,6 +21,7 @@ from simready_check import (
     requirement_ids,
     validate,
 )
+from test_usd import drop_normals
 
 SEEDS = ("asimov", "ecn_2r", "rosie_1000", "rosie_1400", "rosie_600")
 #: requirements that cannot hold for any kit, each with the reason
@@ -91,16 +92,19 @@ def test_the_validation_covers_the_profile_and_the_isaac_tier():
     [  # a defect in one payload layer is found on the composed stage
         ("physics.usda", '"PhysicsJointStateAPI:angular", ', "", "DJ.002"),
         ("physics.usda", 'token isaac:robotType = "Manipulator"', "", "RC.008"),
-        ("geometries.usd", "normal3f[] primvars:normals", "normal3f[] primvars:unused", "VG.027"),
+        ("geometries.usd", "/geometries/link_1/collision_00", None, "VG.027"),
     ],
 )
 def test_a_defect_fails_the_validation(tmp_path, layer, old, new, requirement):
     _validators()
     entry = _write("ecn_2r", tmp_path)
     path = entry.parent / "payloads" / layer
-    text = path.read_text(encoding="utf-8")
-    assert old in text
-    path.write_text(text.replace(old, new), encoding="utf-8")
+    if new is None:  # the binary geometry: `old` names a mesh to strip of its normals
+        drop_normals(path, old)
+    else:
+        text = path.read_text(encoding="utf-8")
+        assert old in text
+        path.write_text(text.replace(old, new), encoding="utf-8")
     failed = {p.requirement for p in validate(entry, requirements())}
     assert f"com.nvidia.simready.{requirement}" in failed or f"com.nvidia.usd.{requirement}" in (
         failed

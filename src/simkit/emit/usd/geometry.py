@@ -25,8 +25,10 @@ INSTANCES = "instances"
 LOOKS = "Looks"
 
 
-def geometries_text(robot: Robot) -> str:
-    """`/geometries/LINK/visual` and `/geometries/LINK/collision_NN` meshes."""
+def geometries_layer(robot: Robot):
+    """`/geometries/LINK/visual` and `/geometries/LINK/collision_NN` meshes, as an Sdf layer
+    (written as a binary crate: the mesh arrays are most of the asset, and a CAD robot's
+    normals in text would pass the kit size cap)."""
     layer, stage, _top = new_stage(robot, GEOMETRIES, "Scope")
     for link in robot.links:
         base = f"/{GEOMETRIES}/{prim_name(link.name)}"
@@ -39,7 +41,7 @@ def geometries_text(robot: Robot) -> str:
         if kind == "meshes":
             for i, piece in enumerate(pieces):
                 mesh(stage, f"{base}/{piece_name(i)}", piece)
-    return export(layer)
+    return layer
 
 
 #: the material of a drawn link whose spec gives none (its colour: `Robot.material_rgba`)
