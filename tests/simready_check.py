@@ -15,8 +15,6 @@ import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-import tomllib
-
 PROFILE = "Robot-Body"
 #: the profile's neutral features (no runtime suffix) and its required packaging features
 NEUTRAL = "_STANDARD"
@@ -129,6 +127,7 @@ def _features() -> dict[tuple[str, str], dict]:
 def profile_features(profile: str = PROFILE) -> tuple[str, list[tuple[str, str]]]:
     """(newest version, [(feature id, version)]) of the profile's neutral features, required
     and optional."""
+    import tomllib  # Python 3.11+
     from simready.foundation import tier_core
 
     text = (tier_core.tier.profiles_path / "robot_body.toml").read_text()

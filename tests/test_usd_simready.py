@@ -36,6 +36,7 @@ EXEMPT = {
 def _validators() -> None:
     try:  # imported here only to know they are installed (validate runs them in a child)
         import physx_usd_schemas  # noqa: F401
+        import tomllib  # noqa: F401  (the profile files are TOML; Python 3.11+)
         import usd.schema.isaac  # noqa: F401
         import usd_validation_nvidia  # noqa: F401
         from simready.foundation import tier_core, tier_isaac  # noqa: F401
