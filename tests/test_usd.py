@@ -91,12 +91,12 @@ def test_stage_layout(rosie_1000):
     # kp = effort_peak / 0.01 rad = 33000 N m/rad -> per degree
     assert drive.GetStiffnessAttr().Get() == pytest.approx(33000 * np.pi / 180, rel=1e-6)
     visual = UsdGeom.Mesh(stage.GetPrimAtPath("/rosie_1000/link_2/visuals/link_2"))
-    normals = UsdGeom.PrimvarsAPI(visual).GetPrimvar("normals").Get()  # issue 25: a primvar
+    normals = UsdGeom.PrimvarsAPI(visual).GetPrimvar("normals").ComputeFlattened()  # issue 25
     assert len(normals) == len(visual.GetFaceVertexIndicesAttr().Get())
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
-    layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix == ".usda"]
-    assert len(layers) == 6  # and the binary geometries.usd
+    layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix in (".usd", ".usda")]
+    assert len(layers) == 7
     for path in sorted(layers):
         text = path.read_text(encoding="utf-8")
         assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
@@ -328,7 +328,7 @@ def test_visual_normals_are_face_varying_primvars_equal_to_the_glb_normals():
         prim = stage.GetPrimAtPath(f"/rosie_1000/{mesh['name']}/visuals/{mesh['name']}")
         primvar = UsdGeom.PrimvarsAPI(prim).GetPrimvar("normals")
         assert primvar.GetInterpolation() == UsdGeom.Tokens.faceVarying
-        normals = np.array(primvar.Get()).reshape(-1, 3, 3)
+        normals = np.array(primvar.ComputeFlattened()).reshape(-1, 3, 3)  # indexed values
         attrs = mesh["primitives"][0]["attributes"]
         triangles = accessor(mesh["primitives"][0]["indices"], "<u2", 1).reshape(-1, 3)
         from_glb = accessor(attrs["NORMAL"], "<f4", 3)[triangles]
@@ -350,7 +350,7 @@ def test_broken_payload_layer_fails(rosie_1000, tmp_path):
 
 
 def drop_normals(path: Path, mesh: str) -> None:
-    """Remove one mesh's normals from a layer (the geometry is a binary crate)."""
+    """Remove one mesh's normal values from a layer (text or crate)."""
     from pxr import Sdf
 
     layer = Sdf.Layer.FindOrOpen(str(path))

@@ -43,9 +43,7 @@ def test_files_and_layers(tmp_path):
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / rel).write_bytes(data)
         if rel.endswith((".usd", ".usda")):
-            # text, so that reviews see the changes; the meshes a crate, as in Isaac's assets
-            crate = rel.endswith("geometries.usd")
-            assert data.startswith(b"PXR-USDC" if crate else b"#usda 1.0"), rel
+            assert data.startswith(b"#usda 1.0"), rel  # text, so that reviews see changes
             layer = Sdf.Layer.FindOrOpen(str(tmp_path / rel))
             assert layer.defaultPrim, rel
     stage = Usd.Stage.Open(str(tmp_path / "usd/ecn_2r.usda"))
@@ -61,7 +59,7 @@ def test_files_and_layers(tmp_path):
     assert meta["mass"] == pytest.approx(robot.total_mass, rel=1e-9)
 
 
-def test_binary_format_writes_the_entry_as_a_crate_too():
+def test_binary_format_writes_the_entry_and_the_geometry_as_crates():
     files = usd.emit_binary(model_from_spec("ecn_2r"))
     assert files["usd/ecn_2r.usdc"].startswith(b"PXR-USDC")
     assert files["usd/payloads/geometries.usd"].startswith(b"PXR-USDC")

@@ -5,8 +5,8 @@ Files (Z up, metres, kilograms; each layer has a default prim; docs/usd.md):
 
 - `usd/NAME.usda`: the interface layer, the entry point (interface.py);
 - `usd/payloads/base.usda`: the hierarchy, `/NAME/LINK` Xforms at q = 0 (base.py);
-- `usd/payloads/geometries.usd` (binary crate), `instances.usda`, `materials.usda`: meshes,
-  the links' visuals and colliders, the materials (geometry.py);
+- `usd/payloads/geometries.usd`, `instances.usda`, `materials.usda`: meshes, the links'
+  visuals and colliders, the materials (geometry.py);
 - `usd/payloads/physics.usda`, `physx.usda`: UsdPhysics and the PhysX additions (physics.py,
   physx.py, robot_schema.py);
 - `usd/.thumbs/256x256/NAME.usda.png`: the thumbnail (thumbnail.py).
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from simkit.emit.usd.base import base_text
 from simkit.emit.usd.common import axis_frame, place, prim_name
-from simkit.emit.usd.geometry import geometries_layer, instances_text, materials_text
+from simkit.emit.usd.geometry import geometries_text, instances_text, materials_text
 from simkit.emit.usd.interface import DEFAULT_VARIANT, VARIANT_SET, VARIANTS, interface_text
 from simkit.emit.usd.physics import physics_text
 from simkit.emit.usd.physx import physx_text
@@ -47,15 +47,15 @@ __all__ = [
 ]
 
 FORMATS = ("usda", "usdc")
-#: the meshes: a binary crate in every format, as in Isaac Sim's assets (one crate of geometry,
-#: text layers for the rest); `simkit diff` reads the meshes through the STLs anyway
+#: the meshes, in text (`.usd` reads both encodings), or a crate with `--usd-format usdc`
 GEOMETRIES = "geometries.usd"
 
 
 def layers(robot: Robot) -> dict[str, str]:
-    """Payload file name -> `.usda` text, for every text layer."""
+    """Payload file name -> `.usda` text."""
     return {
         "base.usda": base_text(robot),
+        GEOMETRIES: geometries_text(robot),
         "instances.usda": instances_text(robot),
         "materials.usda": materials_text(robot),
         "physics.usda": physics_text(robot),
@@ -63,25 +63,20 @@ def layers(robot: Robot) -> dict[str, str]:
     }
 
 
-def _crate(layer) -> bytes:
-    """Binary crate bytes of a layer. pxr writes crate files only to disk, so this goes
-    through a private temporary folder that is removed again."""
+def _usdc_bytes(text: str) -> bytes:
+    """Binary crate bytes of a `.usda` text. pxr writes crate files only to disk, so this
+    goes through a private temporary folder that is removed again."""
     import tempfile
     from pathlib import Path
 
-    with tempfile.TemporaryDirectory(prefix="simkit-usdc-") as tmp:
-        target = Path(tmp) / "layer.usdc"
-        layer.Export(str(target))
-        return target.read_bytes()
-
-
-def _usdc_bytes(text: str) -> bytes:
-    """Binary crate bytes of a `.usda` text."""
     from pxr import Sdf
 
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.ImportFromString(text)
-    return _crate(layer)
+    with tempfile.TemporaryDirectory(prefix="simkit-usdc-") as tmp:
+        target = Path(tmp) / "stage.usdc"
+        layer.Export(str(target))
+        return target.read_bytes()
 
 
 def emit(robot: Robot, binary: bool = False) -> dict[str, bytes]:
@@ -89,15 +84,16 @@ def emit(robot: Robot, binary: bool = False) -> dict[str, bytes]:
     and its thumbnail."""
     entry = interface_text(robot)
     files = {layout.usd(robot.name, binary): _usdc_bytes(entry) if binary else entry.encode()}
-    files[layout.usd_payload(GEOMETRIES)] = _crate(geometries_layer(robot))
     for name, text in layers(robot).items():
-        files[layout.usd_payload(name)] = text.encode()
+        crate = binary and name == GEOMETRIES
+        files[layout.usd_payload(name)] = _usdc_bytes(text) if crate else text.encode()
     files[layout.usd_thumbnail(robot.name, binary)] = thumbnail_png(robot)
     return dict(sorted(files.items()))
 
 
 def emit_binary(robot: Robot) -> dict[str, bytes]:
-    """The same asset as `emit`, with the entry layer in USD's binary crate format too."""
+    """The same asset as `emit`, with the entry layer and the geometry in USD's binary crate
+    format."""
     return emit(robot, binary=True)
 
 

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from simkit.kitio.fmt import rounded
-from simkit.kitio.normals import corner_normals
+from simkit.kitio.normals import corner_normals, face_normals
 from simkit.model.kinematics import quat_wxyz, rpy_matrix
 from simkit.model.robot import Mesh, Robot, Shape
 
@@ -104,9 +104,12 @@ def axis_frame(axis: Sequence[float]) -> tuple[str, np.ndarray]:
     return "X", np.column_stack([x, y, np.cross(x, y)])
 
 
-def mesh(stage, path: str, data: Mesh):
-    """A UsdGeom.Mesh with face-varying normals (kitio/normals.py, as the GLB's: smooth on
-    curved surfaces, sharp at creases); collision pieces get them too (SimReady VG.027)."""
+def mesh(stage, path: str, data: Mesh, shaded: bool = True):
+    """A UsdGeom.Mesh with normals (collision pieces too: SimReady VG.027). `shaded`: the
+    GLB's face-varying normals (kitio/normals.py: smooth on curved surfaces, sharp at
+    creases); else one normal per face, exact for a convex piece and a third of the text.
+    Normals keep 6 decimals (within 1e-6 of the GLB's), so that a CAD robot's geometries.usd
+    stays under the kit size cap."""
     from pxr import Gf, Sdf, UsdGeom, Vt
 
     geom = UsdGeom.Mesh.Define(stage, path)
@@ -116,10 +119,16 @@ def mesh(stage, path: str, data: Mesh):
     geom.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(data.faces.reshape(-1).astype(np.int32)))
     lo, hi = arr.min(axis=0), arr.max(axis=0)
     geom.CreateExtentAttr(Vt.Vec3fArray([Gf.Vec3f(*lo.tolist()), Gf.Vec3f(*hi.tolist())]))
-    normals = corner_normals(data.vertices, data.faces).reshape(-1, 3).astype(np.float32)
+    if shaded:
+        normals = corner_normals(data.vertices, data.faces).reshape(-1, 3)
+        interpolation = UsdGeom.Tokens.faceVarying
+    else:
+        normals = face_normals(data.vertices, data.faces)
+        interpolation = UsdGeom.Tokens.uniform
+    values = np.ascontiguousarray(np.round(normals, 6) + 0.0, dtype=np.float32)
     UsdGeom.PrimvarsAPI(geom).CreatePrimvar(
-        "normals", Sdf.ValueTypeNames.Normal3fArray, UsdGeom.Tokens.faceVarying
-    ).Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(normals)))
+        "normals", Sdf.ValueTypeNames.Normal3fArray, interpolation
+    ).Set(Vt.Vec3fArray.FromNumpy(values))
     geom.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     return geom
 

@@ -25,10 +25,8 @@ INSTANCES = "instances"
 LOOKS = "Looks"
 
 
-def geometries_layer(robot: Robot):
-    """`/geometries/LINK/visual` and `/geometries/LINK/collision_NN` meshes, as an Sdf layer
-    (written as a binary crate: the mesh arrays are most of the asset, and a CAD robot's
-    normals in text would pass the kit size cap)."""
+def geometries_text(robot: Robot) -> str:
+    """`/geometries/LINK/visual` and `/geometries/LINK/collision_NN` meshes."""
     layer, stage, _top = new_stage(robot, GEOMETRIES, "Scope")
     for link in robot.links:
         base = f"/{GEOMETRIES}/{prim_name(link.name)}"
@@ -40,8 +38,8 @@ def geometries_layer(robot: Robot):
             mesh(stage, f"{base}/visual", link.solid)
         if kind == "meshes":
             for i, piece in enumerate(pieces):
-                mesh(stage, f"{base}/{piece_name(i)}", piece)
-    return layer
+                mesh(stage, f"{base}/{piece_name(i)}", piece, shaded=False)
+    return export(layer)
 
 
 #: the material of a drawn link whose spec gives none (its colour: `Robot.material_rgba`)
