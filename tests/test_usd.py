@@ -146,6 +146,12 @@ def test_rebuild_is_byte_identical(rosie_1000):
             "usd.physics.bodies",
         ),
         ("usd/payloads/base.usda", 'upAxis = "Z"', 'upAxis = "Y"', "usd.layers"),
+        (  # physics in the geometry-only variant
+            USDA,
+            '"none" {',
+            '"none" (\n            prepend payload = @./payloads/physics.usda@\n        ) {',
+            "usd.none.geometry_only",
+        ),
     ],
 )
 def test_corrupted_usd_fails(rosie_1000, tmp_path, rel, old, new, check):
