@@ -22,6 +22,7 @@ from simkit.pipeline import build, model_from_spec
 
 SPECS = Path(__file__).resolve().parent / "specs"
 USDA = "usd/rosie_1000.usda"
+PHYSICS = "usd/payloads/physics.usda"
 KEY_CHECKS = (
     "usd.validate",
     "usd.stage",
@@ -38,6 +39,17 @@ KEY_CHECKS = (
     "usd.fk",
     "usd.fk.rotation",
     "usd.xforms",
+    # issue 33: the Isaac asset structure, and the agreement in the other physics variant
+    "usd.layers",
+    "usd.normals",
+    "usd.thumbnail",
+    "usd.robot_schema",
+    "usd.none.geometry_only",
+    "usd.physics.mass",
+    "usd.physics.joint_frames",
+    "usd.physics.drive.stiffness",
+    "usd.physics.colliders",
+    "usd.physics.xforms",
 )
 
 
@@ -79,41 +91,75 @@ def test_stage_layout(rosie_1000):
     # kp = effort_peak / 0.01 rad = 33000 N m/rad -> per degree
     assert drive.GetStiffnessAttr().Get() == pytest.approx(33000 * np.pi / 180, rel=1e-6)
     visual = UsdGeom.Mesh(stage.GetPrimAtPath("/rosie_1000/link_2/visuals/link_2"))
-    normals = UsdGeom.PrimvarsAPI(visual).GetPrimvar("normals").Get()  # issue 25: a primvar
+    normals = UsdGeom.PrimvarsAPI(visual).GetPrimvar("normals").ComputeFlattened()  # issue 25
     assert len(normals) == len(visual.GetFaceVertexIndicesAttr().Get())
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
-    text = (rosie_1000.kit_dir / USDA).read_text(encoding="utf-8")
-    assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
+    layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix in (".usd", ".usda")]
+    assert len(layers) == 7
+    for path in sorted(layers):
+        text = path.read_text(encoding="utf-8")
+        assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
 
 
 def test_rebuild_is_byte_identical(rosie_1000):
-    written = (rosie_1000.kit_dir / USDA).read_bytes()
-    assert usd.emit(model_from_spec("rosie_1000"))[USDA] == written
     robot = model_from_spec("rosie_1000")
-    assert usd.emit(robot)[USDA] == written
+    files = usd.emit(robot)
+    assert len(files) == 8  # entry, six payload layers, thumbnail
+    for rel, data in files.items():
+        assert (rosie_1000.kit_dir / rel).read_bytes() == data, rel
     assert usd.emit_binary(robot) == usd.emit_binary(robot)
 
 
 @pytest.mark.parametrize(
-    ("old", "new", "check"),
+    ("rel", "old", "new", "check"),
     [
-        ("float physics:mass = 7.2\n", "float physics:mass = 7.3\n", "usd.mass"),
-        ('uniform token physics:axis = "Y"', 'uniform token physics:axis = "Z"', "usd.axes"),
-        ("float physics:upperLimit = 135\n", "float physics:upperLimit = 136\n", "usd.limits"),
+        (PHYSICS, "float physics:mass = 7.2\n", "float physics:mass = 7.3\n", "usd.mass"),
+        (
+            PHYSICS,
+            'uniform token physics:axis = "Y"',
+            'uniform token physics:axis = "Z"',
+            "usd.axes",
+        ),
+        (
+            PHYSICS,
+            "float physics:upperLimit = 135\n",
+            "float physics:upperLimit = 136\n",
+            "usd.limits",
+        ),
         (  # a material binding without MaterialBindingAPI: usd-core's validators object
+            "usd/payloads/base.usda",
             'prepend apiSchemas = ["MaterialBindingAPI"]',
             'prepend apiSchemas = ["NotAnAPI"]',
             "usd.validate",
         ),
+        (  # the PhysX variant's layer drops the UsdPhysics payload: caught in that variant
+            USDA,
+            "@./payloads/physx.usda@,\n                @./payloads/physics.usda@",
+            "@./payloads/physx.usda@",
+            "usd.bodies",
+        ),
+        (  # the generic variant composes the PhysX layer alone: that variant's finding fails
+            USDA,
+            "payload = @./payloads/physics.usda@",
+            "payload = @./payloads/physx.usda@",
+            "usd.physics.bodies",
+        ),
+        ("usd/payloads/base.usda", 'upAxis = "Z"', 'upAxis = "Y"', "usd.layers"),
+        (  # physics in the geometry-only variant
+            USDA,
+            '"none" {',
+            '"none" (\n            prepend payload = @./payloads/physics.usda@\n        ) {',
+            "usd.none.geometry_only",
+        ),
     ],
 )
-def test_corrupted_usd_fails(rosie_1000, tmp_path, old, new, check):
+def test_corrupted_usd_fails(rosie_1000, tmp_path, rel, old, new, check):
     kit = tmp_path / "kit"
     shutil.copytree(rosie_1000.kit_dir, kit)
-    text = (kit / USDA).read_text(encoding="utf-8")
+    text = (kit / rel).read_text(encoding="utf-8")
     assert old in text
-    (kit / USDA).write_text(text.replace(old, new, 1), encoding="utf-8")
+    (kit / rel).write_text(text.replace(old, new, 1), encoding="utf-8")
     failed = {f.check for f in check_usd(Kit.open(kit)) if not f.ok}
     assert check in failed
 
@@ -213,8 +259,8 @@ def test_every_robot_usd_checked_and_reproducible(name, kit_factory):
         expected |= {"usd.primitives", "usd.drive.targetPosition"}  # capsules, toe springs
     assert expected <= set(found), sorted(expected - set(found))
     assert all(f.ok for f in found.values()), [f.line() for f in found.values() if not f.ok]
-    rel = f"usd/{name}.usda"
-    assert usd.emit(model_from_spec(name))[rel] == (kit.kit_dir / rel).read_bytes()
+    for rel, data in usd.emit(model_from_spec(name)).items():
+        assert (kit.kit_dir / rel).read_bytes() == data, rel
 
 
 def test_passive_springs_are_drives(kit_factory, tmp_path):
@@ -224,8 +270,8 @@ def test_passive_springs_are_drives(kit_factory, tmp_path):
     from pxr import Usd, UsdPhysics
 
     kit = kit_factory("asimov")
-    path = kit.kit_dir / "usd/asimov.usda"
-    stage = Usd.Stage.Open(str(path))
+    path = kit.kit_dir / PHYSICS.replace("rosie_1000", "asimov")
+    stage = Usd.Stage.Open(str(kit.kit_dir / "usd/asimov.usda"))
     for side in ("left", "right"):
         prim = stage.GetPrimAtPath(f"/asimov/joints/{side}_toe_joint")
         assert prim.HasAPI(UsdPhysics.DriveAPI, "angular")
@@ -241,7 +287,7 @@ def test_passive_springs_are_drives(kit_factory, tmp_path):
     text = path.read_text(encoding="utf-8")
     old = "float drive:angular:physics:stiffness = 0.07853982\n"
     assert text.count(old) == 2
-    (copy / "usd/asimov.usda").write_text(text.replace(old, old.replace("0.0785", "0.0885")))
+    (copy / PHYSICS).write_text(text.replace(old, old.replace("0.0785", "0.0885")))
     assert "usd.drive.stiffness" in {f.check for f in check_usd(Kit.open(copy)) if not f.ok}
 
 
@@ -251,13 +297,13 @@ def test_orient_keeps_small_turns_as_usd_reads_them(angle):
     3.8e-6 rad (a humanoid's elbow link in the corpus) must not come back unturned."""
     from pxr import Usd, UsdGeom
 
-    from simkit.emit.usd import _place
+    from simkit.emit.usd import place
     from simkit.model.kinematics import rpy_matrix
 
     rot = rpy_matrix((0.0, angle, 0.5 * angle))
     stage = Usd.Stage.CreateInMemory()
     prim = UsdGeom.Xform.Define(stage, "/link").GetPrim()
-    _place(prim, (0.1, 0.0, 0.0), rot)
+    place(prim, (0.1, 0.0, 0.0), rot)
     world = np.array(UsdGeom.XformCache().GetLocalToWorldTransform(prim)).T
     assert np.abs(world[:3, :3] - rot).max() < 1e-8
 
@@ -288,7 +334,7 @@ def test_visual_normals_are_face_varying_primvars_equal_to_the_glb_normals():
         prim = stage.GetPrimAtPath(f"/rosie_1000/{mesh['name']}/visuals/{mesh['name']}")
         primvar = UsdGeom.PrimvarsAPI(prim).GetPrimvar("normals")
         assert primvar.GetInterpolation() == UsdGeom.Tokens.faceVarying
-        normals = np.array(primvar.Get()).reshape(-1, 3, 3)
+        normals = np.array(primvar.ComputeFlattened()).reshape(-1, 3, 3)  # indexed values
         attrs = mesh["primitives"][0]["attributes"]
         triangles = accessor(mesh["primitives"][0]["indices"], "<u2", 1).reshape(-1, 3)
         from_glb = accessor(attrs["NORMAL"], "<f4", 3)[triangles]
@@ -299,3 +345,30 @@ def test_visual_normals_are_face_varying_primvars_equal_to_the_glb_normals():
         assert (spread > 0.01).any() and (spread == 0).any()
         checked += 1
     assert checked == sum(link.solid is not None for link in robot.links)
+
+
+def test_broken_payload_layer_fails(rosie_1000, tmp_path):
+    """A payload layer that does not parse is one finding, not a crash."""
+    kit = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, kit)
+    (kit / PHYSICS).write_text("#usda 1.0\ndef Xform {\n", encoding="utf-8")
+    assert [f.check for f in check_usd(Kit.open(kit)) if not f.ok] == ["usd.open"]
+
+
+def drop_normals(path: Path, mesh: str) -> None:
+    """Remove one mesh's normal values from a layer (text or crate)."""
+    from pxr import Sdf
+
+    layer = Sdf.Layer.FindOrOpen(str(path))
+    spec = layer.GetPrimAtPath(mesh)
+    spec.RemoveProperty(spec.properties["primvars:normals"])
+    layer.Save()
+
+
+def test_a_mesh_without_normals_fails(rosie_1000, tmp_path):
+    kit = tmp_path / "kit"
+    shutil.copytree(rosie_1000.kit_dir, kit)
+    drop_normals(kit / "usd/payloads/geometries.usd", "/geometries/link_2/collision_00")
+    failed = [f for f in check_usd(Kit.open(kit)) if not f.ok]
+    assert [f.check for f in failed] == ["usd.normals"]
+    assert "/rosie_1000/link_2/collisions/collision_00" in failed[0].detail

@@ -5,6 +5,7 @@ tool pose at random configurations composed from the USD joints)."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import mujoco
@@ -12,7 +13,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
-from simkit.check.mujoco import body_pose, load_control_mjcf, site_or_body_pose
+from simkit.check.mujoco import load_control_mjcf
 from simkit.check.readers.usd import (
     UsdJoint,
     UsdKinematics,
@@ -20,19 +21,24 @@ from simkit.check.readers.usd import (
     joints_from_schemas,
     matrix,
     parse_physics,
+    prim_name,
     validate,
 )
 from simkit.check.usd_collision import collision_findings
+from simkit.check.usd_fk import fk_findings
+from simkit.check.usd_layout import (
+    VARIANT_SET,
+    geometry_only_findings,
+    layer_findings,
+    normals_findings,
+    robot_schema_findings,
+    thumbnail_findings,
+)
 from simkit.kitio import layout
 
-N_RANDOM = 25
-SEED = 1
 #: USD stores masses, inertia, joint frames and drive gains as 32-bit floats (about 7
 #: significant digits): relative tolerance for values compared one by one.
 FLOAT32_REL = 1e-6
-#: Tool pose through 6+ float32 joint frames: metres, and rotation-matrix entries.
-FK_TOL_M = 1e-6
-FK_TOL_ROT = 1e-6
 
 
 def usd_path(kit: Kit) -> Path | None:
@@ -122,8 +128,6 @@ def _to_welded(mj, child: int, parent: str, joint: UsdJoint) -> bool:
 def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str]) -> list[Finding]:
     """Every USD joint joins the MJCF parent and child bodies at the MJCF body frame; movable
     joints have the MJCF axis, limits and servo. `names`: USD path -> link name."""
-    from simkit.emit.usd import prim_name
-
     wrong, frames_exp, frames_act = [], [], []
     for j in joints:
         child = mujoco.mj_name2id(mj, mujoco.mjtObj.mjOBJ_BODY, names.get(j.body1, "?"))
@@ -240,147 +244,112 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
     return findings
 
 
-def _fk_findings(kit: Kit, mj, kin: UsdKinematics, paths: dict[str, str]) -> list[Finding]:
-    """T_base_tool and T_base_link of every link, composed from the USD joints, vs MuJoCo at
-    q = 0 and seeded random configurations; and the authored Xforms vs the joints at q = 0."""
-    from simkit.emit.usd import prim_name
-
-    tool, base = kit.doc.get("tool_frame"), kit.base_frame
-    links = [link["name"] for link in kit.doc["links"]]
-    targets = links + ([tool] if tool and tool in paths else [])
-    joints = [j for j in kit.joints if j["type"] in ("revolute", "continuous", "prismatic")]
-    rng = np.random.default_rng(SEED)
-    lower = [j["lower"] if j["lower"] is not None else -np.pi for j in joints]
-    upper = [j["upper"] if j["upper"] is not None else np.pi for j in joints]
-    configs = np.vstack([np.zeros(len(joints)), rng.uniform(lower, upper, (N_RANDOM, len(joints)))])
-    data = mujoco.MjData(mj)
-    qadr = [int(mj.jnt_qposadr[mj.joint(j["name"]).id]) for j in joints]
-    exp, act = [], []
-    for q in configs:
-        data.qpos[qadr] = q
-        mujoco.mj_kinematics(mj, data)
-        inv = np.linalg.inv(body_pose(mj, data, base))
-        exp.append([inv @ site_or_body_pose(mj, data, t) for t in targets])
-        poses = kin.poses({prim_name(j["name"]): v for j, v in zip(joints, q, strict=True)})
-        inv = np.linalg.inv(kin.pose(poses, paths[base]))
-        act.append([inv @ kin.pose(poses, paths[t]) for t in targets])
-    exp, act = np.array(exp), np.array(act)
-    rest = kin.poses({})
-    label = f"in {base} at q = 0 and {N_RANDOM} random configurations, from the USD joints"
-    findings = [
-        compare(
-            "usd.fk.links",
-            f"every link pose {label}",
-            exp[:, : len(links), :3],
-            act[:, : len(links), :3],
-            FK_TOL_M,
-            "m or 1",
-        ),
-        compare(
-            "usd.xforms",
-            "authored link Xforms vs the joints composed at q = 0",
-            [kin.world[paths[n]] for n in links],
-            [rest[paths[n]] for n in links],
-            1e-6,
-            "m or 1",
-        ),
-    ]
-    if len(targets) > len(links):
-        findings += [
-            compare(
-                "usd.fk",
-                f"{tool} position {label}",
-                exp[:, -1, :3, 3],
-                act[:, -1, :3, 3],
-                FK_TOL_M,
-                "m",
-            ),
-            compare(
-                "usd.fk.rotation",
-                f"{tool} rotation {label}",
-                exp[:, -1, :3, :3],
-                act[:, -1, :3, :3],
-                FK_TOL_ROT,
-                "",
-            ),
-        ]
-    return findings
-
-
-def check_usd(kit: Kit) -> list[Finding]:
-    """Validate the USD, parse its physics, and compare it with the MJCF in MuJoCo."""
+def _open(kit: Kit):
+    """(stage, entry path, findings so far): the composed stage of the entry layer, every
+    payload loaded, with the usd-core validators' and the stage metadata's findings."""
     from pxr import Usd, UsdGeom, UsdPhysics
-
-    from simkit.emit.usd import prim_name
 
     path = usd_path(kit)
     if path is None:
-        return [require("usd.present", False, f"no {layout.usd(kit.name)} (or .usdc) in the kit")]
+        return None, None, [require("usd.present", False, f"no {layout.usd(kit.name)} (or .usdc)")]
     rel = path.relative_to(kit.root).as_posix()
     try:
-        stage = Usd.Stage.Open(str(path))
+        stage = Usd.Stage.Open(str(path), Usd.Stage.LoadAll)
     except Exception as exc:  # pxr raises Tf.ErrorException with the parser's message
-        return [require("usd.open", False, f"{rel}: {exc}")]
-    errors, warns = validate(stage)
-    findings = [
-        require(
-            "usd.validate",
-            not errors,
-            f"{rel}: usd-core validators found "
-            f"{len(errors)} error(s), {warns} warning(s){': ' if errors else ''}"
-            f"{'; '.join(errors[:3])}",
-        )
+        return None, path, [require("usd.open", False, f"{rel}: {exc}")]
+    broken = [
+        " ".join(str(e).replace(f"{path.parent}/", "").split())[:240]
+        for e in stage.GetCompositionErrors()
     ]
+    if broken:  # a layer that does not open or parse, an arc to nothing
+        return stage, path, [require("usd.open", False, f"{rel}: {'; '.join(broken[:3])}")]
+    errors, warns = validate(stage)
     top = stage.GetDefaultPrim()
     meta = (
         UsdGeom.GetStageUpAxis(stage),
         UsdGeom.GetStageMetersPerUnit(stage),
         UsdPhysics.GetStageKilogramsPerUnit(stage),
     )
-    findings.append(
-        require(
-            "usd.stage",
-            bool(top) and meta == ("Z", 1.0, 1.0),
-            f"defaultPrim {top.GetPath() if top else None}, upAxis, metersPerUnit, "
-            f"kilogramsPerUnit {meta} (Z, 1, 1)",
-        )
+    return (
+        stage,
+        path,
+        [
+            require(
+                "usd.validate",
+                not errors,
+                f"{rel}: usd-core validators found "
+                f"{len(errors)} error(s), {warns} warning(s){': ' if errors else ''}"
+                f"{'; '.join(errors[:3])}",
+            ),
+            require(
+                "usd.stage",
+                bool(top) and meta == ("Z", 1.0, 1.0),
+                f"defaultPrim {top.GetPath() if top else None}, upAxis, metersPerUnit, "
+                f"kilogramsPerUnit {meta} (Z, 1, 1)",
+            ),
+        ],
     )
-    if not top:
+
+
+def check_usd(kit: Kit) -> list[Finding]:
+    """Validate the USD, check its layout, and compare the composed stage with the MJCF in
+    MuJoCo in every physics variant (names `usd.X` for the default variant, `usd.VARIANT.X`
+    for the others; the "none" variant must hold no physics)."""
+    stage, path, findings = _open(kit)
+    top = stage.GetDefaultPrim() if stage is not None else None
+    if not top or not all(f.ok for f in findings if f.check == "usd.open"):
         return findings
+    findings += layer_findings(stage) + normals_findings(stage) + thumbnail_findings(path)
+    variants = top.GetVariantSet(VARIANT_SET)
+    names = variants.GetVariantNames() if top.HasVariantSets() else []
+    if not names:  # a one-layer stage (kits before the Isaac asset structure)
+        return findings + _physics(kit, stage, top)
+    default = variants.GetVariantSelection()
+    for name in names:
+        _select(stage, top, name)
+        if name == "none":
+            findings += geometry_only_findings(stage)
+            continue
+        found = _physics(kit, stage, top)
+        if name != default:
+            found = [replace(f, check=f"usd.{name}.{f.check[4:]}") for f in found]
+        findings += found
+    _select(stage, top, default)
+    return findings
+
+
+def _select(stage, top, variant: str) -> None:
+    """Select a physics variant in the session layer (the files stay as written)."""
+    from pxr import Usd
+
+    with Usd.EditContext(stage, stage.GetSessionLayer()):
+        top.GetVariantSet(VARIANT_SET).SetVariantSelection(variant)
+
+
+def _physics(kit: Kit, stage, top) -> list[Finding]:
+    """Rigid bodies, the articulation, masses, joints, colliders, the robot schema and the
+    FK of the composed stage vs the MJCF."""
+    from pxr import Usd, UsdGeom, UsdPhysics
+
     root = str(top.GetPath())
     links = {link["name"]: f"{root}/{prim_name(link['name'])}" for link in kit.doc["links"]}
     missing = [
         n for n, p in links.items() if not stage.GetPrimAtPath(p).HasAPI(UsdPhysics.RigidBodyAPI)
     ]
-    findings.append(
-        require("usd.bodies", not missing, f"a rigid body per link (missing {missing})")
-    )
+    findings = [require("usd.bodies", not missing, f"a rigid body per link (missing {missing})")]
     if missing:
         return findings
     parsed = parse_physics(stage)
     if parsed is not None:
         joints = joints_from_parser(parsed)
-        arts = parsed.get(UsdPhysics.ObjectType.Articulation, ([], []))[1]
-        held = {str(b) for a in arts for b in a.articulatedBodies}
-        moved = {str(p) for a in arts for p in a.articulatedJoints}
-        held |= {b for j in joints if j.path in moved for b in (j.body0, j.body1)}
-        # the parser may leave out a body whose only joint is the articulated one from the
-        # world (a hinged cube); a rigid robot (a drone's frame and props, fixed or
-        # floating) has no joint to articulate
-        need = {links[n] for n in kit.moved_links() if n in links}
-        findings.append(
-            require(
-                "usd.articulation",
-                (len(arts) == 1 and need <= held) or (not need and len(arts) <= 1),
-                f"UsdPhysics parser: {len(arts)} articulation(s) holding every link a joint "
-                f"moves ({len(need)} of {len(links)})",
-            )
-        )
+        findings.append(_articulation(kit, parsed, joints, links))
     else:
         joints = joints_from_schemas(stage)
     mj = load_control_mjcf(kit)  # the servos the USD drives mirror
     findings += _mass_findings(stage, mj, links)
     findings += _joint_findings(mj, kit, joints, {p: n for n, p in links.items()})
+    if top.GetRelationship("isaac:physics:robotLinks"):
+        findings += robot_schema_findings(stage, top, links, [j.path for j in joints])
     if parsed is not None:
         findings += collision_findings(parsed, mj, links)
     xforms: dict[str, str] = {}
@@ -395,7 +364,27 @@ def check_usd(kit: Kit) -> list[Finding]:
     paths.update(links)
     paths.update({n: root for n, f in kit.doc.get("frames", {}).items() if "parent" not in f})
     try:
-        findings += _fk_findings(kit, mj, UsdKinematics(stage, joints), paths)
+        findings += fk_findings(kit, mj, UsdKinematics(stage, joints), paths)
     except (ValueError, KeyError) as exc:  # joints that do not form a tree, unknown bodies
         findings.append(require("usd.fk", False, f"cannot compose the USD joints: {exc}"))
     return findings
+
+
+def _articulation(kit: Kit, parsed: dict, joints: list[UsdJoint], links: dict) -> Finding:
+    """Exactly one articulation, holding every link a joint moves."""
+    from pxr import UsdPhysics
+
+    arts = parsed.get(UsdPhysics.ObjectType.Articulation, ([], []))[1]
+    held = {str(b) for a in arts for b in a.articulatedBodies}
+    moved = {str(p) for a in arts for p in a.articulatedJoints}
+    held |= {b for j in joints if j.path in moved for b in (j.body0, j.body1)}
+    # the parser may leave out a body whose only joint is the articulated one from the world
+    # (a hinged cube); a rigid robot (a drone's frame and props, fixed or floating) has no
+    # joint to articulate
+    need = {links[n] for n in kit.moved_links() if n in links}
+    return require(
+        "usd.articulation",
+        (len(arts) == 1 and need <= held) or (not need and len(arts) <= 1),
+        f"UsdPhysics parser: {len(arts)} articulation(s) holding every link a joint "
+        f"moves ({len(need)} of {len(links)})",
+    )

@@ -50,7 +50,23 @@ def glb(robot: str) -> str:
 
 
 def usd(robot: str, binary: bool = False) -> str:
+    """The USD entry point: the interface layer of Isaac Sim's robot asset structure."""
     return f"usd/{robot}.{'usdc' if binary else 'usda'}"
+
+
+#: the interface layer's payload layers, named as Isaac Sim's asset structure and the SimReady
+#: composition rule (ISA.001) name them, in their own folder beside it
+USD_PAYLOADS = "usd/payloads"
+
+
+def usd_payload(layer: str) -> str:
+    """`base.usda` -> `usd/payloads/base.usda`."""
+    return f"{USD_PAYLOADS}/{layer}"
+
+
+def usd_thumbnail(robot: str, binary: bool = False) -> str:
+    """The entry layer's thumbnail where Omniverse and the SimReady rules look for it."""
+    return f"usd/.thumbs/256x256/{usd(robot, binary).rsplit('/', 1)[-1]}.png"
 
 
 def visual_mesh(link: str) -> str:

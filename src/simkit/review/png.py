@@ -1,24 +1,15 @@
-"""PNG files through Pillow, written the same way every time: RGB, 8 bits, no text or time
-chunks, a fixed zlib level, so the same pixels give the same bytes."""
+"""PNG files of renders and diff pages: the bytes come from kitio/png.py (RGB, 8 bits, no
+text or time chunks, a fixed zlib level), so the same pixels give the same bytes."""
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
-COMPRESS_LEVEL = 6
+from simkit.kitio.png import COMPRESS_LEVEL, png_bytes
 
-
-def png_bytes(pixels: np.ndarray) -> bytes:
-    """An (H, W, 3) uint8 RGB array as PNG bytes."""
-    from PIL import Image
-
-    buf = io.BytesIO()
-    image = Image.fromarray(np.ascontiguousarray(pixels, dtype=np.uint8), "RGB")
-    image.save(buf, format="PNG", compress_level=COMPRESS_LEVEL)
-    return buf.getvalue()
+__all__ = ["COMPRESS_LEVEL", "png_bytes", "read_png", "write_png"]
 
 
 def write_png(path: Path, pixels: np.ndarray) -> None:

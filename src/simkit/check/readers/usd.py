@@ -31,6 +31,13 @@ class UsdJoint:
     drive: tuple[float, float, float, float] | None
 
 
+def prim_name(name: str) -> str:
+    """The prim name USD gives a spec name (Tf.MakeValidIdentifier, as a USD writer must)."""
+    from pxr import Tf
+
+    return Tf.MakeValidIdentifier(name)
+
+
 def matrix(pos, quat) -> np.ndarray:
     """4x4 column-convention transform from a Gf vector and Gf quaternion."""
     out = np.eye(4)

@@ -1,0 +1,124 @@
+"""USD emitter: the robot as an Isaac Sim robot asset (UsdPhysics articulation, PhysX variant,
+Isaac robot schema) for Isaac Sim, Isaac Lab, Newton and other USD consumers.
+
+Files (Z up, metres, kilograms; each layer has a default prim; docs/usd.md):
+
+- `usd/NAME.usda`: the interface layer, the entry point (interface.py);
+- `usd/payloads/base.usda`: the hierarchy, `/NAME/LINK` Xforms at q = 0 (base.py);
+- `usd/payloads/geometries.usd`, `instances.usda`, `materials.usda`: meshes, the links'
+  visuals and colliders, the materials (geometry.py);
+- `usd/payloads/physics.usda`, `physx.usda`: UsdPhysics and the PhysX additions (physics.py,
+  physx.py, robot_schema.py);
+- `usd/.thumbs/256x256/NAME.usda.png`: the thumbnail (thumbnail.py).
+
+Layers are built in memory and serialised with `Sdf.Layer.ExportToString`, so the text holds no
+file names, timestamps or absolute paths; numbers are rounded as `fmt.num` prints them, so the
+same model gives the same bytes.
+"""
+
+from __future__ import annotations
+
+from simkit.emit.usd.base import base_text
+from simkit.emit.usd.common import axis_frame, place, prim_name
+from simkit.emit.usd.geometry import geometries_text, instances_text, materials_text
+from simkit.emit.usd.interface import DEFAULT_VARIANT, VARIANT_SET, VARIANTS, interface_text
+from simkit.emit.usd.physics import physics_text
+from simkit.emit.usd.physx import physx_text
+from simkit.emit.usd.thumbnail import thumbnail_png
+from simkit.errors import SimkitError
+from simkit.kitio import layout
+from simkit.model.inertia import principal_axes
+from simkit.model.robot import Robot
+
+__all__ = [
+    "DEFAULT_VARIANT",
+    "FORMATS",
+    "VARIANTS",
+    "VARIANT_SET",
+    "axis_frame",
+    "emit",
+    "emit_binary",
+    "emitter",
+    "layers",
+    "place",
+    "prim_name",
+    "principal_axes",
+    "stage_text",
+]
+
+FORMATS = ("usda", "usdc")
+#: the meshes, in text (`.usd` reads both encodings), or a crate with `--usd-format usdc`
+GEOMETRIES = "geometries.usd"
+
+
+def layers(robot: Robot) -> dict[str, str]:
+    """Payload file name -> `.usda` text."""
+    return {
+        "base.usda": base_text(robot),
+        GEOMETRIES: geometries_text(robot),
+        "instances.usda": instances_text(robot),
+        "materials.usda": materials_text(robot),
+        "physics.usda": physics_text(robot),
+        "physx.usda": physx_text(robot),
+    }
+
+
+def _usdc_bytes(text: str) -> bytes:
+    """Binary crate bytes of a `.usda` text. pxr writes crate files only to disk, so this
+    goes through a private temporary folder that is removed again."""
+    import tempfile
+    from pathlib import Path
+
+    from pxr import Sdf
+
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.ImportFromString(text)
+    with tempfile.TemporaryDirectory(prefix="simkit-usdc-") as tmp:
+        target = Path(tmp) / "stage.usdc"
+        layer.Export(str(target))
+        return target.read_bytes()
+
+
+def emit(robot: Robot, binary: bool = False) -> dict[str, bytes]:
+    """The entry layer `usd/NAME.usda` (or `.usdc` with `binary=True`), its payload layers
+    and its thumbnail."""
+    entry = interface_text(robot)
+    files = {layout.usd(robot.name, binary): _usdc_bytes(entry) if binary else entry.encode()}
+    for name, text in layers(robot).items():
+        crate = binary and name == GEOMETRIES
+        files[layout.usd_payload(name)] = _usdc_bytes(text) if crate else text.encode()
+    files[layout.usd_thumbnail(robot.name, binary)] = thumbnail_png(robot)
+    return dict(sorted(files.items()))
+
+
+def emit_binary(robot: Robot) -> dict[str, bytes]:
+    """The same asset as `emit`, with the entry layer and the geometry in USD's binary crate
+    format."""
+    return emit(robot, binary=True)
+
+
+def emitter(usd_format: str = "usda"):
+    """The USD emitter for `usda` (text, the default) or `usdc` (binary)."""
+    if usd_format not in FORMATS:
+        raise SimkitError(f"unknown USD format '{usd_format}' (expected one of {FORMATS})")
+    return emit if usd_format == "usda" else emit_binary
+
+
+def stage_text(robot: Robot, variant: str = DEFAULT_VARIANT) -> str:
+    """The composed stage in one `.usda` text (the variant's payloads flattened in): for
+    tests and tools that want the whole robot in memory. Writes the files to a private
+    temporary folder that is removed again."""
+    import tempfile
+    from pathlib import Path
+
+    from pxr import Usd
+
+    with tempfile.TemporaryDirectory(prefix="simkit-usd-") as tmp:
+        for rel, data in emit(robot).items():
+            target = Path(tmp) / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+        stage = Usd.Stage.Open(str(Path(tmp) / layout.usd(robot.name)))
+        top = stage.GetDefaultPrim()
+        top.GetVariantSet(VARIANT_SET).SetVariantSelection(variant)
+        return stage.Flatten().ExportToString()
