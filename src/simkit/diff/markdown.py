@@ -23,6 +23,7 @@ TITLES = {
     "mesh": "Meshes (link frame)",
     "collision": "Collision pieces",
     "step": "STEP solids (assembly frame, mm)",
+    "usd": "USD stage (composed, per physics variant)",
     "robot_json": "Other robot.json entries",
 }
 #: numbers of one value listed in a cell

@@ -16,8 +16,8 @@ from simkit.diff.tolerance import PARAM_SI, quantize
 
 @dataclass(frozen=True)
 class Change:
-    """One semantic change: `kind` is joint, link, mesh, collision, step or robot_json; `change`
-    is modified, added or removed. `old` and `new` are kept at `tolerance` (the absolute
+    """One semantic change: `kind` is joint, link, mesh, collision, step, usd or robot_json;
+    `change` is modified, added or removed. `old` and `new` are kept at `tolerance` (the absolute
     tolerance of the quantity, in `unit`; 0 for counts and words): every number is rounded to
     it and a number below it is 0, so no output can print round-off as a change."""
 

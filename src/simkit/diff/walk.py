@@ -20,6 +20,7 @@ from simkit.diff.kit import load_kit
 from simkit.diff.mesh import mesh_changes
 from simkit.diff.report import Change, Report
 from simkit.diff.scene import glb_close, usd_close
+from simkit.diff.stage import is_usd, stage_changes
 from simkit.diff.step import step_changes
 from simkit.diff.tolerance import PARAM_SI, leaf_changes, same, text_close, tolerance
 from simkit.errors import SimkitError
@@ -188,10 +189,17 @@ def diff_files(
                 )
             )
     report.changes += _other_entries(a, b)
+    usd = None
+    if any(is_usd(p) for p in [*differ, *report.added, *report.removed]):
+        usd = stage_changes(old, new)  # None: not composable, compared file by file below
+        report.changes += usd or []
     for key in METADATA_KEYS:
         report.metadata += [p for p, _x, _y in leaf_changes(a.get(key), b.get(key), 0.0, key)]
     for path in differ:
-        kind = _round_off(path, old[path], new[path], report.changes)
+        if usd is not None and is_usd(path):
+            kind = not any(c.kind == "usd" for c in report.changes)
+        else:
+            kind = _round_off(path, old[path], new[path], report.changes)
         (report.round_off if kind else report.changed).append(path)
     return report
 
