@@ -14,8 +14,9 @@ Colliders, per link (`colliders`):
 - any other piece (CoACD, given hulls): the kit's own OBJ piece, its hull capped at
   `MAX_HULL_VERTICES` vertices (MuJoCo's `maxhullvert`).
 MJX collides cylinders only with planes, spheres, capsules and cylinders: against a box or a
-mesh, a cylinder's circumscribed box stands in for it (in that pair only), so no collider
-turns into a mesh (MJX compiles one collision function per distinct mesh pair).
+mesh, a cylinder's circumscribed box stands in for it, in that pair only (the inscribed box
+where the circumscribed one would touch at a named pose that the cylinder does not). So no
+collider turns into a mesh (MJX compiles one collision function per distinct mesh pair).
 
 Pairs (`contact pairs`): the collider pairs in contact in any of the seeded configurations the
 SRDF's sampling draws (derive/collision_pairs.py), except the link pairs the main MJCF never
@@ -106,6 +107,45 @@ def stand_ins(kinds: dict[str, str], pairs: list[list[str]]) -> dict[str, list[s
             if kinds[x] == "cylinder" and mujoco_type(kinds.get(y, "plane")) in ("box", "mesh"):
                 out.setdefault(x, []).append(y)
     return {k: sorted(v) for k, v in sorted(out.items())}
+
+
+def stand_in_box(geom: dict, half: float) -> dict:
+    """A cylinder's stand-in: the box of half side `half` (m) along its axis, its length."""
+    size = [2 * half, 2 * half, geom["length"]]
+    return {
+        "link": geom["link"],
+        "name": f"{geom['name']}_box",
+        "kind": "box",
+        "size": size,
+        "xyz": geom["xyz"],
+        "rpy": geom["rpy"],
+        "class": geom.get("class"),
+    }
+
+
+def _named_rows(robot: Robot) -> np.ndarray:
+    """Every named pose (zeros without any) in sampled-joint order."""
+    names = [j.name for j in robot.movable_joints]
+    order = [n for n, _, _ in sampled_joints(robot)]
+    rows = [dict(zip(names, q, strict=True)) for _, q in robot.poses] or [{}]
+    return np.array([[row.get(n, 0.0) for n in order] for row in rows], dtype=float)
+
+
+def inscribed_stand_ins(robot: Robot, geoms: list[dict], swaps: dict) -> set[str]:
+    """Cylinders whose circumscribed box touches a partner at a named pose where the cylinder
+    does not: the servos hold those poses, so the box would push where the main MJCF has no
+    contact. They get the inscribed box (inside the cylinder: it touches only where the
+    cylinder does)."""
+    by_name = {g["name"]: g for g in geoms}
+    boxes = [stand_in_box(by_name[name], by_name[name]["radius"]) for name in swaps]
+    out = set()
+    for _depth, touching in sampled_contacts(robot, geoms + boxes, _named_rows(robot)):
+        for name, partners in swaps.items():
+            for partner in partners:
+                box = tuple(sorted((f"{name}_box", partner)))
+                if box in touching and tuple(sorted((name, partner))) not in touching:
+                    out.add(name)
+    return out
 
 
 def peak_slots(kinds: dict[str, str], contacts: list[tuple[float, set]], swaps: dict) -> int | None:
@@ -259,8 +299,13 @@ def derive_gpu_scene(robot: Robot) -> Robot:
     for geom in geoms:
         if geom["name"] in swaps:
             geom["box_for"] = swaps[geom["name"]]
+            geom["box_half"] = geom["radius"]
         if geom["kind"] == "piece" and len(piece_vertices(robot, geom)) > MAX_HULL_VERTICES:
             geom["maxhullvert"] = MAX_HULL_VERTICES
+    inscribed = inscribed_stand_ins(robot, geoms, swaps) if swaps else set()
+    for geom in geoms:
+        if geom["name"] in inscribed:
+            geom["box_half"] = geom["radius"] / math.sqrt(2)
     standing = sum(pair_slots(kinds, FLOOR, g) for g in floor)
     every = standing + sum(pair_slots(kinds, a, b, swaps) for a, b in pairs)
     peak = peak_slots(kinds, contacts, swaps)

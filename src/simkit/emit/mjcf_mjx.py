@@ -49,10 +49,10 @@ def _collider(body: ET.Element, geom: dict) -> None:
         return
     element = mjcf.primitive(body, _shape(geom), geom["name"])
     element.attrib.update(NO_CONTACT)
-    if "box_for" in geom:  # the cylinder's circumscribed box, for pairs MJX cannot collide
-        radius, half = geom["radius"], geom["length"] / 2
+    if "box_for" in geom:  # the cylinder's stand-in box, for pairs MJX cannot collide
+        side, half = geom["box_half"], geom["length"] / 2
         attrs = {"name": f"{geom['name']}_box", "class": "collision", "type": "box"}
-        attrs.update(size=vec((radius, radius, half)), pos=vec(geom["xyz"]))
+        attrs.update(size=vec((side, side, half)), pos=vec(geom["xyz"]))
         if element.get("quat") is not None:
             attrs["quat"] = element.get("quat")  # type: ignore[assignment]
         sub(body, "geom", {**attrs, **NO_CONTACT})
