@@ -14,7 +14,7 @@ from simkit.check.kit import Kit
 from simkit.check.source import check_source
 
 SOURCE = arm(
-    '<joint name="j1" axis="0 1 0" pos="0 0 0.02" range="-1 1"/>'
+    '<joint name="j1" axis="0 1 0" pos="0 0 0.02" ref="0.3" range="-1 1"/>'
     '<body name="tip" pos="0 0 0.2"><joint name="j2" type="slide" axis="0 0 1" range="0 0.1"/>'
     '<inertial pos="0 0 0" mass="0.5" diaginertia="0.001 0.001 0.001"/></body>',
     '<actuator><motor name="m1" joint="j1" gear="10" ctrlrange="-1 1"/></actuator>',

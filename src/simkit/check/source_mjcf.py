@@ -119,6 +119,13 @@ class Pairs:
         obj = mujoco.mjtObj.mjOBJ_BODY if kind == "body" else mujoco.mjtObj.mjOBJ_JOINT
         return mujoco.mj_name2id(self.kit, obj, new)
 
+    def kit_site(self, name: str) -> int:
+        """The kit's site (a frame) of a massless source body `name` (-1: none)."""
+        import mujoco
+
+        new = self.allowed.links.get(one_line(name), name)
+        return mujoco.mj_name2id(self.kit, mujoco.mjtObj.mjOBJ_SITE, new)
+
     def listed(self, key: str) -> bool:
         return key in self.allowed.keys
 
@@ -209,8 +216,8 @@ def _bodies(p: Pairs) -> list[str]:
         name = _name(p.source, "body", b)
         kb = p.kit_id("body", name)
         if kb < 0:
-            massless_root = b == p.root and p.source.body_mass[b] == 0  # the kit's world
-            if not p.listed(f"links.{name}") and not massless_root:
+            massless = p.source.body_mass[b] == 0 and (b == p.root or p.kit_site(name) >= 0)
+            if not p.listed(f"links.{name}") and not massless:  # the kit's world or a frame
                 out.append(f"link '{name}' is missing from the kit")
             continue
         m0, c0, i0 = _mass_properties(p.source, b, p.offset[b])
@@ -276,6 +283,7 @@ def _fk(p: Pairs) -> list[str]:
     if ref_k < 0:
         return [f"the root body '{root_name}' is missing from the kit"]
     pairs = [(b, p.kit_id("body", _name(s, "body", b))) for b in p.bodies]
+    sites = [(b, p.kit_site(_name(s, "body", b))) for b, kb in pairs if kb < 0]
     pairs = [(b, kb) for b, kb in pairs if kb >= 0]
     ds, dk = mujoco.MjData(s), mujoco.MjData(k)
     rng = np.random.default_rng(0)
@@ -287,10 +295,15 @@ def _fk(p: Pairs) -> list[str]:
         rs, rk = ds.xmat[ref_s].reshape(3, 3), dk.xmat[ref_k].reshape(3, 3)
         os_ = ds.xpos[ref_s] + rs @ p.offset[ref_s]
         ok = dk.xpos[ref_k] + rk @ p.kit_offset[ref_k]
-        for b, kb in pairs:
-            ms, mk = ds.xmat[b].reshape(3, 3), dk.xmat[kb].reshape(3, 3)
+        kit_poses = [(b, dk.xpos[kb] + dk.xmat[kb].reshape(3, 3) @ p.kit_offset[kb],
+                      dk.xmat[kb].reshape(3, 3)) for b, kb in pairs]  # fmt: skip
+        kit_poses += [
+            (b, dk.site_xpos[k], dk.site_xmat[k].reshape(3, 3)) for b, k in sites if k >= 0
+        ]
+        for b, kit_x, mk in kit_poses:
+            ms = ds.xmat[b].reshape(3, 3)
             xs = rs.T @ (ds.xpos[b] + ms @ p.offset[b] - os_)
-            xk = rk.T @ (dk.xpos[kb] + mk @ p.kit_offset[kb] - ok)
+            xk = rk.T @ (kit_x - ok)
             err = max(float(np.max(np.abs(xs - xk))), float(np.max(np.abs(rs.T @ ms - rk.T @ mk))))
             if err > FK_TOL:
                 name = _name(s, "body", b)

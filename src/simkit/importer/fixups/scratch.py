@@ -101,14 +101,10 @@ class Scratch:
             self.geom(body, shape, base_dir, f"{link.name}_{i}")
 
     def geom(self, body: ET.Element, shape, base_dir: Path, name: str) -> None:
-        """One geom of a spec shape in the link frame (a cone: its bounding cylinder). A flat
-        mesh (all its vertices in one plane: a decal) has no hull MuJoCo could collide, nor
-        volume to touch: it is left out of the scratch model."""
+        """One geom of a spec shape in the link frame (a cone: its bounding cylinder)."""
         attrs = {"pos": text(shape.xyz), "quat": text(quat_wxyz(rpy_matrix(shape.rpy)))}
         if shape.kind == "mesh":
             vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
-            if _flat(vertices):
-                return
             ET.SubElement(self.asset, "mesh", name=name, vertex=text(vertices))
             attrs.update(type="mesh", mesh=name)
         elif shape.kind == "box":
@@ -147,15 +143,6 @@ class Scratch:
 
     def xml(self) -> str:
         return ET.tostring(self.root, encoding="unicode")
-
-
-def _flat(vertices: np.ndarray) -> bool:
-    """Whether the points span less than a volume (< 1e-9 of their extent off one plane)."""
-    if len(vertices) < 4:
-        return True
-    centred = vertices - vertices.mean(axis=0)
-    singular = np.linalg.svd(centred, compute_uv=False)
-    return bool(singular[-1] <= 1e-9 * max(float(singular[0]), 1e-300))
 
 
 def compiled(xml: str, joints) -> tuple:

@@ -193,15 +193,29 @@ def _joints(robot, model, body: int, names: Names, off: np.ndarray) -> list[str]
             etree.SubElement(robot, "link", name=child)
             added.append(child)
         joint = etree.SubElement(robot, "joint", name=name_of(model, "jnt", j))
+        turn, shift = _at_zero(model, j, kind)
         if k == 0:
-            _origin(joint, pose_xyz + mat @ at, mat)
+            _origin(joint, pose_xyz + mat @ (at + shift), mat @ turn)
         else:
-            _origin(joint, at - start, np.eye(3))
+            _origin(joint, at - start + shift, turn)
         etree.SubElement(joint, "parent", link=parent_link)
         etree.SubElement(joint, "child", link=child)
         _kind(joint, model, j, kind)
         parent_link, start = child, at
     return added
+
+
+def _at_zero(model, j: int, kind: int) -> tuple[np.ndarray, np.ndarray]:
+    """(rotation, shift m) from the body as written (joint at its `ref`) to the joint at 0:
+    MuJoCo turns a joint by q - ref, the kit by q, so both read the same joint values."""
+    ref = float(model.qpos0[model.jnt_qposadr[j]]) if kind in (HINGE, SLIDE) else 0.0
+    axis = np.asarray(model.jnt_axis[j], dtype=float)
+    if kind == SLIDE:
+        return np.eye(3), -ref * axis
+    x, y, z = axis
+    skew = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    turn = np.eye(3) + np.sin(-ref) * skew + (1 - np.cos(-ref)) * skew @ skew
+    return turn, np.zeros(3)
 
 
 def _kind(joint, model, j: int, kind: int) -> None:
@@ -239,8 +253,10 @@ def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
         int(model.body_geomadr[body]), int(model.body_geomadr[body] + model.body_geomnum[body])
     ):
         kind = int(model.geom_type[g])
-        if kind not in (SPHERE, CAPSULE, CYLINDER, BOX, MESH):
-            continue
+        if kind not in (SPHERE, CAPSULE, CYLINDER, BOX, MESH) or (
+            kind == MESH and mjcf_listed.flat(model, int(model.geom_dataid[g]))
+        ):
+            continue  # listed (mjcf_listed.py)
         tag = (
             "visual"
             if model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0

@@ -47,6 +47,8 @@ def collect(model, root: int, bodies: list[int]) -> list[tuple[str, str]]:
         body, kind = int(model.geom_bodyid[g]), int(model.geom_type[g])
         if body in kept and kind not in (2, 3, 5, 6, 7):
             out.append((f"geoms.{_name(model, 'geom', g)}", "a shape the kit formats lack"))
+        elif body in kept and kind == 7 and flat(model, int(model.geom_dataid[g])):
+            out.append((f"geoms.{_name(model, 'geom', g)}", "a flat mesh: no closed solid"))
         elif body not in kept:
             out.append((f"geoms.{_name(model, 'geom', g)}", "geometry outside the robot's tree"))
     for a in range(model.nu):
@@ -70,6 +72,20 @@ def collect(model, root: int, bodies: list[int]) -> list[tuple[str, str]]:
     if model.body_pos[root].any() or (model.body_quat[root] != (1, 0, 0, 0)).any():
         out.append((f"links.{_name(model, 'body', root)}.pose", "the kit places its root itself"))
     return out
+
+
+def flat(model, mesh: int) -> bool:
+    """Whether a compiled mesh encloses no volume, even as its convex hull (a decal, a
+    screen drawn as one sheet): a kit's solid must be closed, so the geom is listed."""
+    import manifold3d as mf
+
+    start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+    points = np.asarray(model.mesh_vert[start : start + count], dtype=np.float32)
+    if len(points) < 4:
+        return True
+    hull = mf.Manifold.hull_points(points)
+    extent = float(np.ptp(points, axis=0).max())
+    return hull.is_empty() or hull.volume() <= 1e-9 * extent**3
 
 
 def effort(model, j: int) -> float | None:
