@@ -15,10 +15,12 @@ paths relative to the model's folder) with their bytes, for the kept source and 
 from __future__ import annotations
 
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from simkit.errors import SpecError
+from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -68,7 +70,11 @@ def read(shell: Source, options: ReadOptions) -> MjcfSource:
     folder = shell.path.resolve().parent
     allowed = [folder, *(p.resolve() for p in options.allow_read)]
     source.files = _confined(shell.path.resolve(), folder, allowed)
-    source.spec, source.model = _compile(shell.path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        source.spec, source.model = _compile(shell.path)
+    for warning in caught:  # MuJoCo's own warnings (a deprecated attribute): one line each
+        source.note(Position("mujoco", None), f"MuJoCo: {' '.join(str(warning.message).split())}")
     if source.model.nbody > MAX_BODIES:
         raise SpecError(str(shell.path), None, "mujoco", f"over {MAX_BODIES} bodies")
     return source
