@@ -45,6 +45,7 @@ def rpy(mat: np.ndarray) -> np.ndarray:
 
 
 def quat_mat(quat) -> np.ndarray:
+    """The rotation matrix of a unit quaternion (w, x, y, z), MuJoCo's order."""
     w, x, y, z = (float(v) for v in quat)
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
@@ -92,7 +93,7 @@ def robot_root(model, path: Path) -> int:
     return next(iter(tops))
 
 
-def to_tree(source: MjcfSource, scratch: Path):
+def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple[str, str]]]:
     """The URDF-shaped `<robot>` of the compiled model, meshes written as STL into
     `scratch`; returns (root element, floating, listed differences)."""
     from lxml import etree
@@ -138,7 +139,7 @@ class Names:
         return name
 
 
-def _link(robot, model, body: int, name: str, off: np.ndarray):
+def _link(robot, model, body: int, name: str, off: np.ndarray) -> object:
     """`<link>` with its inertial (mass kg, CoM m and principal axes in the link frame)."""
     from lxml import etree
 
@@ -159,6 +160,7 @@ def _link(robot, model, body: int, name: str, off: np.ndarray):
 
 
 def _origin(parent, xyz, mat) -> None:
+    """An `<origin>` (m, URDF rpy rad) under `parent`."""
     from lxml import etree
 
     etree.SubElement(parent, "origin", xyz=fmt(xyz), rpy=fmt(rpy(mat)))
@@ -283,6 +285,7 @@ def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
 
 
 def _rgba(model, g: int) -> np.ndarray:
+    """The geom's colour: its material's rgba, else its own."""
     mat = int(model.geom_matid[g])
     return model.mat_rgba[mat] if mat >= 0 else model.geom_rgba[g]
 
