@@ -75,3 +75,21 @@ def test_an_excluded_pair_touching_at_home_is_refused(tmp_path, monkeypatch):
     monkeypatch.setattr(importer, "STEPS", (translate.to_spec,))
     line = _refused(write(tmp_path, EXCLUDED), tmp_path / "out")
     assert "contact.exclude" in line and "base and link2" in line
+
+
+FALLING = """<mujoco model="m">
+  <worldbody>
+    <body name="pole" pos="0 0 1"><freejoint/>
+      <geom type="capsule" fromto="0 0 -1 0 0 0" size="0.01" mass="1"/>
+      <body name="arm"><joint name="j1" axis="0 1 0" range="-0.1 0.1"/>
+        <geom type="box" pos="0.3 0 0" size="0.3 0.02 0.02" mass="1"/></body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_a_floating_robot_that_cannot_stand_is_refused(tmp_path):
+    """A pole on a round end with an arm to one side falls over: a kit could not hold it."""
+    line = _refused(write(tmp_path, FALLING), tmp_path / "out")
+    assert "does not stand" in line

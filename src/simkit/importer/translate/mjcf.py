@@ -75,6 +75,8 @@ def robot_root(model, path: Path) -> int:
     for j in range(model.njnt):
         top = int(model.body_rootid[model.jnt_bodyid[j]])
         tops[top] = tops.get(top, 0) + 1
+    if model.nbody <= 1:
+        raise SpecError(str(path), None, "worldbody", "no body: a file to include, not a model")
     if not tops:
         raise SpecError(str(path), None, "worldbody", "no joint: nothing for a kit to move")
     if len(tops) > 1:

@@ -11,7 +11,7 @@ import hashlib
 from pathlib import PurePosixPath
 
 from simkit.errors import SpecError
-from simkit.importer.fixups import collide
+from simkit.importer.fixups import collide, settle
 from simkit.importer.fixups.scratch import compiled
 from simkit.importer.read.mjcf import MjcfSource
 
@@ -78,4 +78,29 @@ def refuse_excluded_contact(draft, source: MjcfSource) -> None:
             str(source.path), None, "contact.exclude",
             f"bodies {a} and {b} touch at the kit's home: the MJCF excludes the pair from "
             "contact, a kit cannot carry that (it excludes adjacent links only)",
+        )  # fmt: skip
+
+
+#: m the base may sink while the kit's servos hold home (check/legged.py's drift tolerance)
+DRIFT = 0.02
+
+
+def refuse_falling(draft, source: MjcfSource) -> None:
+    """One line when a floating MJCF robot does not stand on the kit's servos: its base,
+    started on the floor at home, sinks more than `DRIFT` in the import's settle run
+    (fixups/settle.py: its collision geometry, real masses, servos as the kit's). An RL
+    model made to fall (a humanoid on round feet) would fail the kit's standing check."""
+    if not draft.floating:
+        return
+    robot = draft.robot()
+    start, follow = collide.posed(robot)
+    if start is None:
+        return
+    settler = settle.Settler(robot, draft.stage, start, follow)
+    height, rest = settler.height(start), settler.run(start)
+    if height - rest.xyz[2] > DRIFT:
+        raise SpecError(
+            str(source.path), None, "freejoint",
+            f"the floating robot does not stand on a kit's servos at home: its base sinks "
+            f"{height - rest.xyz[2]:.2f} m in {settle.SECONDS:g} s (a kit must hold its pose)",
         )  # fmt: skip
