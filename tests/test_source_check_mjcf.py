@@ -1,6 +1,7 @@
 """The MJCF source proof (issue 31): MuJoCo compiles the source and the kit's MJCF; joints,
 masses and inertias, FK at seeded configurations and actuator force bounds must agree or be
-listed. A tampered axis, mass or kept file fails, naming it."""
+listed. A tampered axis, mass or actuator bound in the kit fails, naming it; a changed
+source fails its digest and is not compiled."""
 
 from __future__ import annotations
 
@@ -83,6 +84,9 @@ def test_an_imported_mjcf_builds_with_its_source_proof(tmp_path):
     assert {"source.digest", "source.joints", "source.links", "source.fk"} <= names
     run = CliRunner().invoke(main, ["check", str(result.kit_dir), "--source", str(source)])
     assert run.exit_code == 0, run.output
+    # a changed source is not the file the import read: it fails its digest and is never
+    # compiled (it may name any file on the machine)
     source.write_text(SOURCE.replace('axis="0 1 0"', 'axis="1 0 0"'))
     run = CliRunner().invoke(main, ["check", str(result.kit_dir), "--source", str(source)])
-    assert "joint 'j1': axis" in run.output and run.exit_code != 0
+    assert "FAIL source.digest" in run.output and run.exit_code != 0
+    assert "source.joints" not in run.output

@@ -10,7 +10,8 @@ the kit's MJCF, and this compares, under the source's names (robot.json renames 
 A difference passes only when robot.json's `source_differences` lists it (key as for a URDF:
 `joints.J.axis`, `links.B.mass`, ...). The source's other files (includes, meshes) are read
 beside the given MODEL.xml, else from the kit source's `NAME.source.assets/SHA256.EXT`,
-each checked against its recorded digest. Frames: the kit's link frame of a body is the body
+each checked against its recorded digest; a source that is not the file the import read
+(its digest differs: check/source.py fails it) is never compiled. Frames: the kit's link frame of a body is the body
 frame moved by its last hinge or ball joint's `pos` (body axes), as the import defines it
 (importer/translate/mjcf.py); this check computes that rule independently.
 """
@@ -42,7 +43,10 @@ def compare(kit: Kit, allowed) -> list[Finding]:
     check/source.py's Allowed (listed keys and renames)."""
     import mujoco
 
-    assets = (kit.doc.get("source") or {}).get("assets") or {}
+    recorded = kit.doc.get("source") or {}
+    if hashlib.sha256(kit.source.read_bytes()).hexdigest() != recorded.get("sha256"):
+        return []  # not the file the import read (source.digest fails): never compiled
+    assets = recorded.get("assets") or {}
     with tempfile.TemporaryDirectory(prefix="simkit-source-") as tmp:
         folder = Path(tmp)
         problems = _lay_out(kit.source, assets, folder)
