@@ -11,9 +11,10 @@ A difference passes only when robot.json's `source_differences` lists it (key as
 `joints.J.axis`, `links.B.mass`, ...). The source's other files (includes, meshes) are read
 beside the given MODEL.xml, else from the kit source's `NAME.source.assets/SHA256.EXT`,
 each checked against its recorded digest; a source that is not the file the import read
-(its digest differs: check/source.py fails it) is never compiled. Frames: the kit's link frame of a body is the body
-frame moved by its last hinge or ball joint's `pos` (body axes), as the import defines it
-(importer/translate/mjcf.py); this check computes that rule independently.
+(its digest differs: check/source.py fails it) is never compiled. Frames: the kit's link
+frame of a body is the body frame moved by its last hinge or ball joint's `pos` (body
+axes), as the import defines it (importer/translate/mjcf.py); this check computes that rule
+independently.
 """
 
 from __future__ import annotations
