@@ -47,6 +47,12 @@ def _from_mjcf(draft: Draft, scratch: Path) -> None:
     source.packages.allow_read = (*source.packages.allow_read, scratch.resolve())
     if draft.options.floating is None:
         draft.options = replace(draft.options, floating=floating)
+        why = (
+            "floating base: the MJCF's root body has a free joint; --fixed-base bolts it"
+            if floating
+            else "fixed base: the MJCF's root body has no free joint; --floating-base frees it"
+        )
+        draft.report.assumed(source, source.root, why)
     draft.kept = replace(source, root=copy.deepcopy(source.root))
 
 
