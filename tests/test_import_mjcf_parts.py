@@ -41,10 +41,3 @@ def test_what_a_kit_cannot_carry_is_listed(spec):
     assert "tendon" in found["tendons.couple"]
     assert "camera" in found["cameras.eye"]
     assert found["sensors.q1"] and found["actuators.m1.gains"]
-
-
-def test_a_keyframe_is_the_first_guess_at_home(tmp_path):
-    text = arm(extra='<keyframe><key name="rest" qpos="0.4"/></keyframe>')
-    spec = spec_of(write(tmp_path, text), tmp_path / "out")
-    assert spec["poses"]["home"] == [pytest.approx(0.4)]
-    assert "keyframes.rest" in listed(spec)

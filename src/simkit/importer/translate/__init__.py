@@ -32,7 +32,6 @@ def to_spec(draft: Draft) -> None:
         try:
             _from_mjcf(draft, scratch)
             _translate(draft)
-            _keyframe_home(draft)
         finally:
             shutil.rmtree(scratch, ignore_errors=True)
         return
@@ -55,17 +54,6 @@ def _from_mjcf(draft: Draft, scratch: Path) -> None:
         )
         draft.report.assumed(source, source.root, why)
     draft.kept = replace(source, root=copy.deepcopy(source.root))
-
-
-def _keyframe_home(draft: Draft) -> None:
-    """An MJCF's keyframe (`home`, else the first) is the spec's first guess at home, where
-    its values lie within the limits (the fix-ups start from it)."""
-    found = mjcf.keyframe_home(draft.source.model, draft.spec, draft.renames.get("joints", {}))
-    if found is None or found[0] == draft.spec["poses"]["home"]:
-        return
-    draft.spec["poses"]["home"] = found[0]
-    draft.note_change(f"home: the MJCF's keyframe '{found[1]}'")
-    draft.changed()
 
 
 def _translate(draft: Draft) -> None:

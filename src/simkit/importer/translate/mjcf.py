@@ -323,27 +323,3 @@ def _sites(robot, model, body: int, names: Names, off: np.ndarray) -> None:
         etree.SubElement(joint, "parent", link=names.links[body])
         etree.SubElement(joint, "child", link=name)
         etree.SubElement(robot, "link", name=name)
-
-
-def keyframe_home(model, spec: dict, renames: dict[str, str]) -> tuple[list[float], str] | None:
-    """The spec's `home` (rad or m, spec joint order) from the MJCF's keyframe named `home`,
-    else its first one: each hinge or slide at the keyframe's value where that lies within
-    the spec joint's limits (else its first guess). None without a keyframe."""
-    if not model.nkey:
-        return None
-    names = [model.key(k).name for k in range(model.nkey)]
-    key = names.index("home") if "home" in names else 0
-    qpos = model.key_qpos[key]
-    values = {}
-    for j in range(model.njnt):
-        if model.jnt_type[j] in (HINGE, SLIDE):
-            name = name_of(model, "jnt", j)
-            values[renames.get(name, name)] = float(qpos[model.jnt_qposadr[j]])
-    movable = [j for j in spec["joints"] if j["type"] not in ("fixed", "floating")]
-    home = list(spec["poses"]["home"])
-    for i, joint in enumerate(movable):
-        value = values.get(joint["name"])
-        low, high = joint.get("lower", -np.inf), joint.get("upper", np.inf)
-        if value is not None and low <= value <= high:
-            home[i] = value
-    return home, names[key] or str(key)
