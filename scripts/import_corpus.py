@@ -1,20 +1,20 @@
-"""Import and build every URDF of a folder with `simkit import`'s default flags; one table.
+"""Import and build every URDF and MJCF of a folder with `simkit import`'s default flags.
 
     python scripts/import_corpus.py CORPUS_DIR [--exclude GLOB ...] [--movable-only]
         [--only GLOB ...] [--title TITLE] [--timeout S] [--out DIR] [--md FILE] [--limit N]
-        [--ray]
+        [--ray] [--mjcf]
 
-Each URDF (sorted by path, `--exclude` globs matched against the path relative to
-CORPUS_DIR): `simkit import URDF --out DIR` with no other flag, a cold build with an empty
-cache, then the same import again into the same folder. It checks issue 22's invariant: an
-import either refuses in one line naming the URDF's own file, or writes a spec that
-validates, builds and compiles in MuJoCo; never a traceback; the re-import gives
-byte-identical files and no stale ones. The table (one per `--title`, default the folder's
-name) goes into docs/import-corpus.md, replacing that corpus's earlier table, with the
-median import + cold build time. Runs one command at a time, or with `--ray` one Ray task
-per URDF ($RAY_ADDRESS, else a local Ray), rows in the same order: the same table. No robot
-is named here.
-"""
+Robot files are found by what they are: `*.urdf`, or with `--mjcf` the `*.xml` whose root
+element is `<mujoco>` (`--movable-only`: with a joint inside a body). Each (sorted by path,
+`--exclude` globs matched against the path relative to CORPUS_DIR): `simkit import URDF
+--out DIR` with no other flag, a cold build with an empty cache, then the same import again
+into the same folder. It checks issue 22's invariant: an import either refuses in one line
+naming the URDF's own file, or writes a spec that validates, builds and compiles in MuJoCo;
+never a traceback; the re-import gives byte-identical files and no stale ones. The table
+(one per `--title`, default the folder's name) goes into docs/import-corpus.md, replacing
+that corpus's earlier table, with the median import + cold build time. Runs one command at a
+time, or with `--ray` one Ray task per URDF ($RAY_ADDRESS, else a local Ray), rows in the
+same order: the same table. No robot is named here."""
 
 from __future__ import annotations
 
@@ -33,12 +33,15 @@ REPO = Path(__file__).resolve().parents[1]
 MOVABLE = {"revolute", "continuous", "prismatic"}
 
 
-def urdfs(root: Path, exclude: list[str], movable_only: bool, only: list[str] = ()) -> list[Path]:
+def urdfs(
+    root: Path, exclude: list[str], movable_only: bool, only: list[str] = (), mjcf: bool = False
+) -> list[Path]:
     """The corpus's URDFs, sorted, less the excluded ones, only those matching `only` if
     given (and those without a movable joint when asked; a file that does not parse is kept:
     the import must refuse it)."""
     out = []
-    for path in sorted(root.rglob("*.urdf")):
+    found = (p for p in root.rglob("*") if _is_mjcf(p)) if mjcf else root.rglob("*.urdf")
+    for path in sorted(found):
         rel = path.relative_to(root).as_posix()
         if any(fnmatch.fnmatch(rel, glob) for glob in exclude):
             continue
@@ -50,7 +53,22 @@ def urdfs(root: Path, exclude: list[str], movable_only: bool, only: list[str] = 
     return out
 
 
+def _is_mjcf(path: Path) -> bool:
+    """An `.xml` file whose root element is `<mujoco>` (an MJCF model or include)."""
+    if path.suffix != ".xml" or not path.is_file():
+        return False
+    with path.open("rb") as handle:
+        head = re.sub(rb"<!--.*?-->|<\?.*?\?>", b"", handle.read(65536), flags=re.S)
+    return re.match(rb"\s*<\s*mujoco[\s>/]", head) is not None
+
+
 def _has_movable(path: Path) -> bool:
+    if path.suffix == ".xml":  # an MJCF: a joint inside a body (not a default class's)
+        try:
+            bodies = ET.parse(path).getroot().iter("body")
+        except ET.ParseError:
+            return True
+        return any(b.find("joint") is not None or b.find("freejoint") is not None for b in bodies)
     try:
         text = path.read_bytes().lstrip()
         root = ET.fromstring(text[text.find(b"<robot") :] if b"<robot" in text else text)
@@ -153,7 +171,8 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
 
 
 def table(rows: list[dict], total: int) -> str:
-    head = "| URDF | base | import | build | invariant | import + cold build s | reason |"
+    kind = "MJCF" if rows and all(r["robot"].endswith(".xml") for r in rows) else "URDF"
+    head = f"| {kind} | base | import | build | invariant | import + cold build s | reason |"
     lines = [head, "|---|---|---|---|---|---:|---|"]
     for r in rows:
         seconds = f"{r['seconds']:.1f}" if r["seconds"] is not None else ""
@@ -206,18 +225,18 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("/tmp/simkit-corpus"))
     parser.add_argument("--md", type=Path, default=REPO / "docs" / "import-corpus.md")
     parser.add_argument("--ray", action="store_true", help="one Ray task per URDF")
+    parser.add_argument("--mjcf", action="store_true", help="MJCF files (<mujoco> root), not URDF")
     args = parser.parse_args()
     root = args.corpus.resolve()
     if not root.is_dir():
         sys.exit(f"{args.corpus}: not a folder")
-    found = urdfs(root, args.exclude, args.movable_only, args.only)
+    found = urdfs(root, args.exclude, args.movable_only, args.only, args.mjcf)
     found = found[: args.limit] if args.limit else found
     title = args.title or root.name
-    command = (
-        "python scripts/import_corpus.py CORPUS "
-        + " ".join(f"--exclude '{g}'" for g in args.exclude)
-        + (" --movable-only" if args.movable_only else "")
-    )
+    flags = [f"--exclude '{g}'" for g in args.exclude] + [f"--only '{g}'" for g in args.only]
+    flags += ["--movable-only"] if args.movable_only else []
+    flags += ["--mjcf"] if args.mjcf else []
+    command = " ".join(["python scripts/import_corpus.py CORPUS", *flags])
 
     def done(rows: list[dict], r: dict) -> None:
         print(f"{r['robot']}: {r['import']} {r['build']} {r['invariant']} {r['reason']}",

@@ -35,7 +35,12 @@ def test_the_reader_is_chosen_by_what_the_file_is(tmp_path):
         "xacro",
         "urdf",
     ]
-    assert set(read.READERS) == {"urdf", "xacro"}
+    assert set(read.READERS) == {"urdf", "xacro", "mjcf"}
+    model = tmp_path / "m.xml"  # an MJCF by its root element, not its name
+    model.write_text("<!-- a model -->\n<mujoco model='m'><worldbody/></mujoco>")
+    assert read.kind_of(model) == "mjcf"
+    (tmp_path / "u.xml").write_text("<robot name='r'><link name='a'/></robot>")
+    assert read.kind_of(tmp_path / "u.xml") == "urdf"
     xacro = tmp_path / "r.urdf.xacro"
     xacro.write_text(
         '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'

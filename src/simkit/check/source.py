@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.check import source_mjcf
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.kitio.oneline import one_line
@@ -105,6 +106,8 @@ def check_source(kit: Kit) -> list[Finding]:
     if kit.source is None:
         return []
     findings = _digest(kit, kit.source)
+    if kit.source.suffix.lower() == ".xml":  # an MJCF: MuJoCo compiles both (source_mjcf.py)
+        return findings + source_mjcf.compare(kit, Allowed.of(kit.doc))
     try:
         source = load_urdf(kit.source)
     except Exception as exc:  # yourdfpy raises several types on bad input

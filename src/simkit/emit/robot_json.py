@@ -331,6 +331,8 @@ def emit(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, byte
     doc["geometry"]["step"] = step_geometry(robot) if step else None
     if robot.source is not None:  # an imported robot; a hand-written spec adds nothing
         doc["source"] = {"file": robot.source[0], "sha256": robot.source[1]}
+        if robot.source_assets:
+            doc["source"]["assets"] = dict(robot.source_assets)
         doc["source_differences"] = [
             {"what": what, "reason": reason, **({"kit": kit} if kit is not None else {})}
             for what, reason, kit in robot.source_differences

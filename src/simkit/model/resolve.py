@@ -223,5 +223,6 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         maintainer_unnamed=spec.maintainer_unnamed,
         license=spec.license,
         source=None if spec.source is None else (spec.source.file, spec.source.sha256),
+        source_assets=() if spec.source is None else tuple(sorted(spec.source.assets.items())),
         source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
     )

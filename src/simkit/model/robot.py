@@ -311,6 +311,8 @@ class Robot:
     license: str | None = None
     #: an import's kept source: (file name beside the spec, SHA-256), or None
     source: tuple[str, str] | None = None
+    #: an MJCF source's other files: (path relative to the source, SHA-256)
+    source_assets: tuple[tuple[str, str], ...] = ()
     #: the kit's intended differences from that source: (what, reason, kit name or None)
     source_differences: tuple[tuple[str, str, str | None], ...] = ()
 

@@ -315,12 +315,28 @@ class PlanningGroupSpec(Strict):
 
 class SourceSpec(Strict):
     """The file a spec was imported from, kept beside it (`simkit import` writes
-    NAME.source.urdf, the expanded URDF), and its SHA-256: the source check compares the kit
-    with it (check/source.py). The kit never carries the file, only the digest."""
+    NAME.source.urdf, the expanded URDF, or NAME.source.xml, the MJCF), and its SHA-256:
+    the source check compares the kit with it (check/source.py). The kit never carries
+    the file, only the digest."""
 
     #: a file name in the spec's folder (no folders, so it cannot point elsewhere)
     file: Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")]
     sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
+    #: an MJCF's other files (includes, meshes, textures): path relative to the source's
+    #: folder -> SHA-256; kept beside the spec as NAME.source.assets/SHA256.EXT
+    assets: dict[
+        Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_./ +-]{0,299}$")],
+        Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")],
+    ] = {}
+
+    @field_validator("assets")
+    @classmethod
+    def _inside(cls, assets: dict[str, str]) -> dict[str, str]:
+        """Each asset path stays inside the source's folder (no `..` part)."""
+        for path in assets:
+            if ".." in path.split("/"):
+                raise ValueError(f"asset path '{path}' leaves the source's folder")
+        return assets
 
 
 class SourceDifference(Strict):

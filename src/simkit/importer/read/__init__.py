@@ -1,9 +1,10 @@
 """Readers: a robot file to a `Source` (read/source.py), one reader per format.
 
-`READERS` maps what the file is (`kind_of`) to its reader; `load` builds the PackageMap and
-picks the reader. Each reader takes a `Source` shell (path, packages, report; no root yet)
-and the user's `ReadOptions`, and returns it with its document parsed. A new format is one
-module here and one row in the table (Drake's `detail_*_parser` per format).
+`READERS` maps what the file is (`kind_of`) to its reader (MJCF: MuJoCo itself,
+read/mjcf.py); `load` builds the PackageMap and picks the reader. Each reader takes a
+`Source` shell (path, packages, report; no root yet) and the user's `ReadOptions`, and
+returns it with its document parsed. A new format is one module here and one row in the
+table (Drake's `detail_*_parser` per format).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from pathlib import Path
 
 from simkit.errors import SpecError
 from simkit.importer.diagnostics import Report
-from simkit.importer.read import urdf, xacro
+from simkit.importer.read import mjcf, urdf, xacro
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.packages import PackageMap
 from simkit.importer.read.source import Source
@@ -22,12 +23,15 @@ from simkit.importer.read.source import Source
 Reader = Callable[[Source, ReadOptions], Source]
 
 #: what the file is -> its reader
-READERS: dict[str, Reader] = {"urdf": urdf.read, "xacro": xacro.read}
+READERS: dict[str, Reader] = {"urdf": urdf.read, "xacro": xacro.read, "mjcf": mjcf.read}
 
 
 def kind_of(path: Path) -> str:
-    """What the file is, by its name: `xacro` (`.xacro`, `.urdf.xacro`), else `urdf`."""
-    return "xacro" if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro") else "urdf"
+    """What the file is: `xacro` by its name (`.xacro`, `.urdf.xacro`), `mjcf` by its
+    `<mujoco>` root element, else `urdf`."""
+    if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro"):
+        return "xacro"
+    return "mjcf" if mjcf.is_mjcf(path) else "urdf"
 
 
 def load(

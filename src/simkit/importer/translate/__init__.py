@@ -9,8 +9,15 @@ and leaves the STEP out when the meshes are too large (step_budget.py).
 
 from __future__ import annotations
 
+import copy
+import shutil
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
 from simkit.importer.draft import Draft
-from simkit.importer.translate import base, blocks, convert, meshes, names
+from simkit.importer.read.mjcf import MjcfSource
+from simkit.importer.translate import base, blocks, convert, meshes, mjcf, names
 from simkit.importer.translate.step_budget import step_fits
 from simkit.importer.translate.up_axis import turn_y_up
 
@@ -18,7 +25,38 @@ from simkit.importer.translate.up_axis import turn_y_up
 def to_spec(draft: Draft) -> None:
     """The URDF to the draft's spec: the base decided, links, joints, frames and kept
     blocks, names made legal, `--strict` problems refused, the STEP left out when the meshes
-    are too large; `draft.meshes` counts the meshes written to the staging folder."""
+    are too large; `draft.meshes` counts the meshes written to the staging folder. An MJCF
+    is first made the URDF-shaped tree this translation takes (mjcf.py)."""
+    if isinstance(draft.source, MjcfSource) and draft.source.root is None:
+        scratch = Path(tempfile.mkdtemp(prefix="simkit-mjcf-"))
+        try:
+            _from_mjcf(draft, scratch)
+            _translate(draft)
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+        return
+    _translate(draft)
+
+
+def _from_mjcf(draft: Draft, scratch: Path) -> None:
+    """The MJCF's tree, its meshes in `scratch` (readable by the mesh reader), the base
+    floating where the MJCF's root has a free joint (unless the user set it), the tree as
+    read kept for the source differences."""
+    source = draft.source
+    source.root, floating, source.listed = mjcf.to_tree(source, scratch)
+    source.packages.allow_read = (*source.packages.allow_read, scratch.resolve())
+    if draft.options.floating is None:
+        draft.options = replace(draft.options, floating=floating)
+        why = (
+            "floating base: the MJCF's root body has a free joint; --fixed-base bolts it"
+            if floating
+            else "fixed base: the MJCF's root body has no free joint; --floating-base frees it"
+        )
+        draft.report.assumed(source, source.root, why)
+    draft.kept = replace(source, root=copy.deepcopy(source.root))
+
+
+def _translate(draft: Draft) -> None:
     source, report, options = draft.source, draft.report, draft.options
     draft.legged, why = base.decide(source)
     floating = options.floating

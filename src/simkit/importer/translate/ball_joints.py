@@ -92,7 +92,7 @@ def _expand_one(source: Source, joint, links: set, joints: set) -> None:
     anchor = next(x for x in source.root.findall("link") if x.get("name") == ends[-1])
     for body in bodies:  # before the child link: the chain keeps its place among siblings
         link = anchor.makeelement("link", {"name": body})
-        link.sourceline = joint.sourceline
+        _keep_line(link, joint)
         anchor.addprevious(link)
 
 
@@ -102,7 +102,7 @@ def _joint(ball, name: str, parent: str, child: str, axis: tuple, ranges) -> obj
     _, xyz, key = axis
     kind = "continuous" if ranges is None else "revolute"
     out = ball.makeelement("joint", {"name": name, "type": kind})
-    out.sourceline = ball.sourceline
+    _keep_line(out, ball)
     for tag, attrs in (("parent", {"link": parent}), ("child", {"link": child})):
         out.append(out.makeelement(tag, attrs))
     origin = ball.find("origin")
@@ -116,7 +116,7 @@ def _joint(ball, name: str, parent: str, child: str, axis: tuple, ranges) -> obj
             half = f"{ranges[[a[2] for a in AXES].index(key)]!r}"
             attrs.update(lower=f"-{half}", upper=half)
         element = out.makeelement("limit", attrs)
-        element.sourceline = limit.sourceline
+        _keep_line(element, limit)
         out.append(element)
     dynamics = ball.find("dynamics")
     if dynamics is not None:
@@ -124,10 +124,17 @@ def _joint(ball, name: str, parent: str, child: str, axis: tuple, ranges) -> obj
     return out
 
 
+def _keep_line(element, origin) -> None:
+    """`element` takes `origin`'s source line, where it has one (an MJCF's tree, built from
+    the compiled model, has none)."""
+    if origin.sourceline is not None:
+        element.sourceline = origin.sourceline
+
+
 def _copy(element):
     """A copy of an element that keeps its source line (for report lines)."""
     out = deepcopy(element)
-    out.sourceline = element.sourceline
+    _keep_line(out, element)
     return out
 
 

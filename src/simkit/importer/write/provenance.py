@@ -15,7 +15,9 @@ import hashlib
 from dataclasses import replace
 
 from simkit.importer.diagnostics import Report
+from simkit.importer.read.mjcf import MjcfSource
 from simkit.importer.read.source import Source, describe, line_of
+from simkit.importer.write import mjcf_source
 from simkit.kitio.oneline import one_line
 from simkit.spec.bounds import MAX_STRING
 
@@ -55,6 +57,19 @@ def keep(draft) -> None:
     from lxml import etree
 
     original = draft.kept
+    if isinstance(original, MjcfSource):  # the MJCF as read and its files (mjcf_source.py)
+        mjcf_source.refuse_excluded_contact(draft, original)
+        mjcf_source.refuse_falling(draft, original)
+        spec = draft.spec
+        spec["source"] = mjcf_source.keep(draft, original)
+        listed = differences(spec, original, draft.report, draft.renames)
+        extra = [{"what": one_line(w), "reason": one_line(r)} for w, r in original.listed]
+        seen = {d["what"] for d in listed}
+        spec["source_differences"] = sorted(
+            listed + [d for d in extra if d["what"] not in seen], key=lambda d: d["what"]
+        )
+        draft.changed()
+        return
     data = etree.tostring(original.root.getroottree(), xml_declaration=True, encoding="utf-8")
     data = data.rstrip(b"\n") + b"\n"
     spec = draft.spec

@@ -1,0 +1,106 @@
+"""The kept source of an MJCF import: the model file as read, byte for byte
+(`NAME.source.xml`), and every other file it read (includes, meshes, textures) as
+`NAME.source.assets/SHA256.EXT`, their digests in the spec's `source` (`assets`: path
+relative to the model's folder -> SHA-256). The source check (check/source_mjcf.py) lays
+them out again and compiles them in MuJoCo, or reads them beside a given MODEL.xml.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import PurePosixPath
+
+from simkit.errors import SpecError
+from simkit.importer.fixups import collide, settle
+from simkit.importer.fixups.scratch import compiled
+from simkit.importer.read.mjcf import MjcfSource
+
+
+def source_name(spec: dict) -> str:
+    """The kept MJCF's file name, beside the spec."""
+    return f"{spec['name']}.source.xml"
+
+
+def keep(draft, source: MjcfSource) -> dict:
+    """Write the kept files into the staging folder; the spec's `source` entry."""
+    name = source_name(draft.spec)
+    main = source.files[_main_key(source)]
+    (draft.stage / name).write_bytes(main)
+    assets: dict[str, str] = {}
+    folder = draft.stage / f"{draft.spec['name']}.source.assets"
+    for rel, data in sorted(source.files.items()):
+        if rel == _main_key(source):
+            continue
+        digest = hashlib.sha256(data).hexdigest()
+        assets[rel] = digest
+        folder.mkdir(exist_ok=True)
+        (folder / f"{digest}{PurePosixPath(rel).suffix.lower()}").write_bytes(data)
+    entry = {"file": name, "sha256": hashlib.sha256(main).hexdigest()}
+    if assets:
+        entry["assets"] = assets
+    return entry
+
+
+def _main_key(source: MjcfSource) -> str:
+    return source.path.name
+
+
+def refuse_excluded_contact(draft, source: MjcfSource) -> None:
+    """One line when two bodies the MJCF excludes from contact (`<exclude>`) still touch at
+    the kit's home: a kit excludes only adjacent links (and pairs touching everywhere), so
+    its contact checks would fail on a pair the source lets overlap. Links collide as in
+    the import's home search (fixups/collide.py: collision hulls and the visual pieces they
+    are grown to cover)."""
+    model = source.model
+    if not model.nexclude:
+        return
+    robot = draft.robot()
+    start, follow = collide.posed(robot)
+    if start is None:
+        return
+    renamed = draft.renames.get("links", {})
+    excluded = set()
+    for e in range(model.nexclude):
+        sig = int(model.exclude_signature[e])
+        a, b = (model.body(i).name for i in (sig >> 16, sig & 0xFFFF))
+        a, b = renamed.get(a, a), renamed.get(b, b)
+        excluded.add((a, b) if a < b else (b, a))
+    xml = collide.model_xml(robot, draft.stage, shapes_of=collide.covered_shapes)
+    built, data, adr = compiled(xml, robot.movable_joints)
+    touching = collide.contacts(built, data, adr, start) & excluded
+    if touching:  # pairs touching almost everywhere: the kit excludes them too
+        shapes = collide.covered_shapes
+        touching -= set(collide.always_touching(robot, draft.stage, start, follow, shapes))
+    touching = sorted(touching)
+    if touching:
+        a, b = touching[0]
+        raise SpecError(
+            str(source.path), None, "contact.exclude",
+            f"bodies {a} and {b} touch at the kit's home: the MJCF excludes the pair from "
+            "contact, a kit cannot carry that (it excludes adjacent links only)",
+        )  # fmt: skip
+
+
+#: m the base may sink while the kit's servos hold home (check/legged.py's drift tolerance)
+DRIFT = 0.02
+
+
+def refuse_falling(draft, source: MjcfSource) -> None:
+    """One line when a floating MJCF robot does not stand on the kit's servos: its base,
+    started on the floor at home, sinks more than `DRIFT` in the import's settle run
+    (fixups/settle.py: its collision geometry, real masses, servos as the kit's). An RL
+    model made to fall (a humanoid on round feet) would fail the kit's standing check."""
+    if not draft.floating:
+        return
+    robot = draft.robot()
+    start, follow = collide.posed(robot)
+    if start is None:
+        return
+    settler = settle.Settler(robot, draft.stage, start, follow)
+    height, rest = settler.height(start), settler.run(start)
+    if height - rest.xyz[2] > DRIFT:
+        raise SpecError(
+            str(source.path), None, "freejoint",
+            f"the floating robot does not stand on a kit's servos at home: its base sinks "
+            f"{height - rest.xyz[2]:.2f} m in {settle.SECONDS:g} s (a kit must hold its pose)",
+        )  # fmt: skip
