@@ -78,5 +78,21 @@ def test_included_body_and_scaled_mesh_become_the_links_solid_and_collision(spec
 
 def test_the_source_and_its_files_are_kept_with_digests(spec, tmp_path_factory):
     source = spec["source"]
-    assert source["file"] == "model.source.xml"
+    assert source["file"] == "classes.source.xml"  # named by <mujoco model="classes">
     assert set(source["assets"]) == {"parts/link.xml", "assets/cube.stl"}
+
+
+def test_the_kit_is_named_by_the_model_attribute(tmp_path):
+    """Robot collections name every model file `robot.xml`: the kit takes `<mujoco model>`,
+    and the file name where the model has none."""
+    from pathlib import Path
+
+    from simkit.importer import robot_name
+
+    named = tmp_path / "robot.xml"
+    named.write_text('<!-- a collection --><mujoco model="Two-Link Arm"><worldbody/></mujoco>')
+    assert robot_name(named) == "two_link_arm"
+    unnamed = tmp_path / "my_arm.xml"
+    unnamed.write_text("<mujoco><worldbody/></mujoco>")
+    assert robot_name(unnamed) == "my_arm"
+    assert robot_name(Path(tmp_path / "absent.urdf")) == "absent"

@@ -28,6 +28,7 @@ from simkit.errors import SpecError
 from simkit.importer import fixups, read, translate, write
 from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.draft import DENSITY, Draft, Options, Unresolvable
+from simkit.importer.read import mjcf
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.write import provenance
 from simkit.importer.write.output import staging
@@ -47,8 +48,9 @@ class Imported:
 
 
 def robot_name(path: Path) -> str:
-    """A spec name (`[a-z][a-z0-9_]*`) from a file name."""
-    stem = path.name.split(".")[0].lower()
+    """A spec name (`[a-z][a-z0-9_]*`) from an MJCF's `model` attribute, else the file name."""
+    model = mjcf.model_name(path) if mjcf.is_mjcf(path) else None
+    stem = (model or path.name.split(".")[0]).lower()
     name = re.sub(r"[^a-z0-9_]+", "_", stem).strip("_") or "robot"
     return name if name[0].isalpha() else f"robot_{name}"
 

@@ -63,6 +63,19 @@ def is_mjcf(path: Path) -> bool:
     return re.match(rb"\s*<\s*mujoco[\s>/]", head) is not None
 
 
+def model_name(path: Path) -> str | None:
+    """The `<mujoco model="...">` attribute (from the file's first 64 KiB), or None: the
+    name a model's authors gave it, where robot collections name every file `robot.xml`."""
+    try:
+        with path.open("rb") as handle:
+            head = handle.read(65536)
+    except OSError:
+        return None
+    head = re.sub(rb"<!--.*?-->", b"", head, flags=re.S)
+    found = re.search(rb"<\s*mujoco\b[^>]*?\bmodel\s*=\s*([\"'])([^\"']*)\1", head)
+    return found.group(2).decode("utf-8", "replace") if found else None
+
+
 def read(shell: Source, options: ReadOptions) -> MjcfSource:
     """`shell`'s file checked (confined, bounded) and compiled by MuJoCo; one line on any
     problem (file, line, element)."""
