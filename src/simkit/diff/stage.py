@@ -61,7 +61,9 @@ def _prims(stage) -> dict[str, dict]:
             name = attr.GetName()
             if name in PROVENANCE or USD_MESH_ARRAYS.fullmatch(f"{name} = []".encode()):
                 continue
-            fields[name] = _plain(attr.Get())
+            value = _plain(attr.Get())
+            if value is not None:  # no value or an empty array: no opinion to compare
+                fields[name] = value
         for rel in prim.GetRelationships():
             fields[rel.GetName()] = sorted(str(t) for t in rel.GetTargets())
         out[str(prim.GetPath())] = fields
