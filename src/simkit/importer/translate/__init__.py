@@ -1,7 +1,8 @@
 """Translate: the read source to the draft's spec (format -> draft), the import's first step.
 
-`to_spec` decides the base from the robot's structure (base.py) unless the user set it,
-turns Y-up COLLADA meshes (up_axis.py), converts links, joints and frames (convert.py with
+`to_spec` declares an undeclared mounting frame (declare.py), decides the base from the
+robot's structure (base.py) unless the user set it, turns Y-up COLLADA meshes (up_axis.py),
+converts links, joints and frames (convert.py with
 links.py, joints.py, geometry.py, meshes.py, masses.py, solids.py, ball_joints.py), makes
 names legal (names.py), keeps the URDF blocks (blocks.py), refuses what `--strict` refuses,
 and leaves the STEP out when the meshes are too large (step_budget.py).
@@ -10,7 +11,7 @@ and leaves the STEP out when the meshes are too large (step_budget.py).
 from __future__ import annotations
 
 from simkit.importer.draft import Draft
-from simkit.importer.translate import base, blocks, convert, meshes, names
+from simkit.importer.translate import base, blocks, convert, declare, meshes, names
 from simkit.importer.translate.step_budget import step_fits
 from simkit.importer.translate.up_axis import turn_y_up
 
@@ -20,6 +21,7 @@ def to_spec(draft: Draft) -> None:
     blocks, names made legal, `--strict` problems refused, the STEP left out when the meshes
     are too large; `draft.meshes` counts the meshes written to the staging folder."""
     source, report, options = draft.source, draft.report, draft.options
+    declare.mounting_frame(source, report)  # an undeclared parent above the root
     draft.legged, why = base.decide(source)
     floating = options.floating
     if floating is None:
