@@ -1,8 +1,8 @@
 """Translate: the read source to the draft's spec (format -> draft), the import's first step.
 
-`to_spec` declares an undeclared mounting frame (declare.py), decides the base from the
-robot's structure (base.py) unless the user set it, turns Y-up COLLADA meshes (up_axis.py),
-converts links, joints and frames (convert.py with
+`to_spec` drops identical duplicate links and joints and declares an undeclared mounting
+frame (declare.py), decides the base from the robot's structure (base.py) unless the user set
+it, turns Y-up COLLADA meshes (up_axis.py), converts links, joints and frames (convert.py with
 links.py, joints.py, geometry.py, meshes.py, masses.py, solids.py, ball_joints.py), makes
 names legal (names.py), keeps the URDF blocks (blocks.py), refuses what `--strict` refuses,
 and leaves the STEP out when the meshes are too large (step_budget.py).
@@ -21,6 +21,7 @@ def to_spec(draft: Draft) -> None:
     blocks, names made legal, `--strict` problems refused, the STEP left out when the meshes
     are too large; `draft.meshes` counts the meshes written to the staging folder."""
     source, report, options = draft.source, draft.report, draft.options
+    declare.identical_duplicates(source, report)  # an include expanded twice
     declare.mounting_frame(source, report)  # an undeclared parent above the root
     draft.legged, why = base.decide(source)
     floating = options.floating

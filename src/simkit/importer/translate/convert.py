@@ -29,7 +29,7 @@ def tree(source: Source) -> tuple[dict, dict, str]:
         if not name:
             raise source.fail(link, "a link needs a name")
         if name in links:
-            raise source.fail(link, f"link '{name}' is defined twice")
+            raise source.fail(link, f"link '{name}' is defined twice, differently")
         links[name] = link
     if not links:
         raise source.fail(source.root, "no <link> in the robot")
@@ -41,7 +41,7 @@ def tree(source: Source) -> tuple[dict, dict, str]:
     joint_names: set = set()
     for joint in source.root.findall("joint"):
         if joint.get("name") in joint_names:
-            raise source.fail(joint, f"joint '{joint.get('name')}' is defined twice")
+            raise source.fail(joint, f"joint '{joint.get('name')}' is defined twice, differently")
         joint_names.add(joint.get("name"))
         for end in ("parent", "child"):
             tag = joint.find(end)

@@ -7,6 +7,9 @@
   so it becomes an empty link there (the kit's root frame), reported on one line. An
   undeclared name inside the tree (a joint's child) or two of them are still refused by
   `convert.tree`, naming the joint.
+- **A link or joint defined twice with identical content** (an include expanded twice)
+  is one element: the later copy is dropped, reported on one line. Two different
+  definitions of a name are refused by `convert.tree`.
 """
 
 from __future__ import annotations
@@ -43,3 +46,33 @@ def mounting_frame(source: Source, report: Report) -> str | None:
         "(the kit's root frame)",
     )
     return name
+
+
+def identical_duplicates(source: Source, report: Report) -> None:
+    """Drop each later `<link>` or `<joint>` whose name and content repeat an earlier one's
+    exactly (attributes, text, children; whitespace and comments aside), one report line
+    each; a different definition of the same name is left for `tree` to refuse."""
+    for tag in ("link", "joint"):
+        first: dict[str, object] = {}
+        for element in source.root.findall(tag):
+            name = element.get("name")
+            if name not in first:
+                first[name] = element
+            elif _same(first[name], element):
+                where = first[name].sourceline
+                report.changed(
+                    source,
+                    element,
+                    f"{tag} '{name}' is defined twice with identical content: this copy is "
+                    f"ignored (the first is on line {where or '?'})",
+                )
+                source.root.remove(element)
+
+
+def _same(a, b) -> bool:
+    """Whether two elements have the same tag, attributes, text and children, in order."""
+    if a.tag != b.tag or dict(a.attrib) != dict(b.attrib):
+        return False
+    if (a.text or "").strip() != (b.text or "").strip() or len(a) != len(b):
+        return False
+    return all(_same(x, y) for x, y in zip(a, b, strict=True))
