@@ -9,31 +9,17 @@ from pathlib import Path
 import yaml
 
 from simkit.importer import import_robot
-
-BOX = '<geometry><box size="0.05 0.05 0.2"/></geometry>'
-
-
-def _link(name: str) -> str:
-    return (
-        f'<link name="{name}"><inertial><mass value="2"/><inertia ixx="0.004" iyy="0.004" '
-        'izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial>'
-        f'<visual><origin xyz="0 0 0.1"/>{BOX}</visual>'
-        f'<collision><origin xyz="0 0 0.1"/>{BOX}</collision></link>'
-    )
+from urdf_parts import joint, link, write
 
 
 def _import(tmp_path: Path, effort: str, velocity: str):
-    urdf = tmp_path / "s.urdf"
-    urdf.write_text(
-        '<?xml version="1.0"?>\n<robot name="s">\n'
-        + _link("base")
-        + _link("arm")
-        + '\n<joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>'
-        '<origin xyz="0 0 0.2"/><axis xyz="1 0 0"/>'
-        f'<limit lower="-1" upper="1" effort="{effort}" velocity="{velocity}"/></joint>\n'
-        "</robot>\n"
+    limit = f'lower="-1" upper="1" effort="{effort}" velocity="{velocity}"'
+    body = (
+        link("base", mass="2"),
+        link("arm", mass="2"),
+        joint("hinge", "base", "arm", limit=limit),
     )
-    done = import_robot(urdf, tmp_path / "out")
+    done = import_robot(write(tmp_path, "s", *body), tmp_path / "out")
     return done, yaml.safe_load(done.spec_path.read_text())
 
 

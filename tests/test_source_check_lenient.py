@@ -7,26 +7,16 @@ from __future__ import annotations
 
 from simkit.check.source import _read_leniently, load_urdf
 from simkit.importer import import_robot
+from urdf_parts import joint, link, write
 
-BOX = '<geometry><box size="0.05 0.05 0.2"/></geometry>'
-LINKS = "".join(
-    f'<link name="{n}"><inertial><mass value="1"/><inertia ixx="0.004" iyy="0.004" '
-    f'izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial><visual>{BOX}</visual>'
-    f"<collision>{BOX}</collision></link>"
-    for n in ("base", "arm")
-)
-JOINT = (
-    '<joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>'
-    '<origin xyz="0 0 0.2"/><axis xyz="1 0 0"/>'
-    '<limit lower="-1" upper="1" effort="20" velocity="2"/></joint>'
-)
+LINKS = link("base") + link("arm")
+JOINT = joint("hinge", "base", "arm")
 
 
 def test_a_nameless_robot_is_compared_as_the_importer_read_it(tmp_path):
     from simkit.pipeline import build
 
-    urdf = tmp_path / "nameless.urdf"
-    urdf.write_text(f'<?xml version="1.0"?>\n<robot>\n{LINKS}\n{JOINT}\n</robot>\n')
+    urdf = write(tmp_path, "nameless", LINKS, JOINT, robot="")
     done = import_robot(urdf, tmp_path / "out")
     result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
     read = [f for f in result.findings if f.check == "source.read"]
