@@ -161,6 +161,7 @@ def convert(
         spec_joints.append(
             {"name": f"{root}_{joint_type}", "type": joint_type, "parent": spec_root, "child": root}
         )
+    drawn = any(link.find("visual") is not None for link in links.values())
     for link_name in links:  # document order
         if link_name == spec_root:
             continue
@@ -184,6 +185,7 @@ def convert(
                 colours,
                 hull_collision,
                 estimate,
+                volume_mass=not drawn,
             )
         )
         if link_name in by_child:
