@@ -50,10 +50,15 @@ def mimics_of(names: Sequence[str], mimic: dict[str, tuple[str, float, float]]) 
 
 
 def coupled(q: Sequence[float], mimics: Sequence[Mimic]) -> list[float]:
-    """`q` with each mimic joint at multiplier x its leader's value + offset."""
+    """`q` with each mimic joint at multiplier x its leader's value + offset (a leader that
+    follows another is set first: one pass per link of the longest chain)."""
     out = [float(v) for v in q]
-    for follower, leader, multiplier, offset in mimics:
-        out[follower] = multiplier * out[leader] + offset
+    for _ in range(len(mimics)):
+        before = list(out)
+        for follower, leader, multiplier, offset in mimics:
+            out[follower] = multiplier * out[leader] + offset
+        if out == before:
+            break
     return out
 
 
@@ -238,12 +243,14 @@ def summary(
             spans[i] = free_range(
                 model, data, adr, home, i, lower[i], upper[i], tol=tol, mimics=mimics
             )
-    for i, (leader, m, o) in followers.items():
-        ends = sorted(m * end + o for end in spans[leader])
-        spans[i] = (rounded(ends[0]), rounded(ends[1]))
+    for _ in range(len(followers)):  # a follower's leader may follow another: in turn
+        for i, (leader, m, o) in followers.items():
+            if i not in spans and leader in spans:
+                ends = sorted(m * end + o for end in spans[leader])
+                spans[i] = (rounded(ends[0]), rounded(ends[1]))
     ranges = []
     for i, name in enumerate(joints):
-        lo, hi = spans[i]
+        lo, hi = spans.get(i, (lower[i], upper[i]))  # a mimic cycle: its limits
         ranges.append(
             {
                 "joint": name,
