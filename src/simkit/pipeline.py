@@ -20,7 +20,7 @@ from simkit.check.findings import Finding
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.emit.ros2 import package_warning
-from simkit.errors import CheckFailed, SpecError, UnknownRobot
+from simkit.errors import CheckFailed, SimkitError, SpecError, UnknownRobot
 from simkit.kitio import atomic, confine, forked, layout, manifest, noop, reuse
 from simkit.kitio.archive import zip_bytes
 from simkit.kitio.cache import (
@@ -92,6 +92,16 @@ def model_from_spec(
         raise spec_locate.locate(exc, doc, spec, path.parent) from None
     except spec_locate.LIBRARY_ERRORS as exc:
         raise spec_locate.refusal(exc, doc) from exc
+
+
+def unstaged(exc: SimkitError, staging: Path | str, out_dir: Path | str) -> SimkitError:
+    """`exc` naming the kit's place under the build's output folder instead of the staging
+    folder the user never sees (`.NAME.XXXX.staging/NAME_description/step/NAME.step` is
+    `OUT/NAME_description/step/NAME.step`); a located SpecError is kept as it is."""
+    text = str(exc)
+    if str(staging) not in text or type(exc) not in (SimkitError, CheckFailed):
+        return exc
+    return type(exc)(text.replace(str(staging), str(out_dir)))
 
 
 def _located(target: str, exc: SpecError) -> SpecError:
@@ -287,9 +297,12 @@ def _build(
         if said:
             print(f"simkit: warning: {said}", file=sys.stderr)
         with atomic.staging_area(out_dir, robot.name) as staging:
-            files, findings, changed = _stage_and_publish(
-                target, robot, files, staging, out_dir, check, say, cache, step
-            )
+            try:
+                files, findings, changed = _stage_and_publish(
+                    target, robot, files, staging, out_dir, check, say, cache, step
+                )
+            except SimkitError as exc:  # a check that refused to read the staged kit
+                raise unstaged(exc, staging, out_dir) from None
     finally:
         atomic.release(lock)
     warning = package_warning(robot)

@@ -11,6 +11,9 @@ Joints whose limits a source publishes (not `estimated` in robot.json) keep them
 links meet inside (Asimov's hip roll lets the legs touch); their sweep covers the collision-free
 range robot.json records (`geometry.self_collision.free_ranges`), and the check verifies that
 record: free inside, and in contact one step beyond it.
+
+Mimic joints move with their leaders in every configuration (robot.json's `mimic`, the MJCF's
+equality): a follower is not swept alone, its leader's sweep moves it (issue 32).
 """
 
 from __future__ import annotations
@@ -47,9 +50,17 @@ class _Model:
         self.adr = sc.joint_addresses(self.model, self.names)
         home = kit.doc.get("home")
         self.home = [float(v) for v in home] if home else [0.0] * len(self.names)
+        mimic = {
+            j["name"]: (j["mimic"]["joint"], j["mimic"]["multiplier"], j["mimic"]["offset"])
+            for j in self.joints
+            if j.get("mimic")
+        }
+        #: mimic joints move with their leaders (the MJCF's equality constraints)
+        self.mimics = sc.mimics_of(self.names, mimic)
+        self.followers = {self.names[f] for f, *_ in self.mimics}
 
     def worst(self, q) -> sc.Contact | None:
-        return sc.worst(self.model, self.data, self.adr, [float(v) for v in q])
+        return sc.worst(self.model, self.data, self.adr, [float(v) for v in q], self.mimics)
 
 
 def _deg(q) -> str:
@@ -200,13 +211,16 @@ def _limits(joint: dict) -> tuple[float, float]:
 
 
 def _sweeps(kit: Kit, m: _Model) -> list[Finding]:
-    """Each joint lower -> upper in 2 deg steps, the others at home."""
+    """Each joint lower -> upper in 2 deg steps, the others at home (mimic joints with
+    their leaders)."""
     recorded = {
         r["joint"]: r
         for r in kit.doc.get("geometry", {}).get("self_collision", {}).get("free_ranges", [])
     }
     out = []
     for i, joint in enumerate(m.joints):
+        if joint["name"] in m.followers:
+            continue  # a mimic joint moves with its leader: swept by the leader's sweep
         lo, hi = _limits(joint)
         note = ""
         if _published_limits(joint) and joint["name"] in recorded:

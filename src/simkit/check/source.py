@@ -67,10 +67,12 @@ def _strtod(text: str) -> str:
     return " ".join(m.group(0) for m in found if m)
 
 
-def _comparable(path: Path) -> bytes:
+def _comparable(path: Path, fixes: list[str] | None = None) -> bytes:
     """The URDF as the comparison reads it: without `<visual>` and `<collision>` (geometry is
     not compared, and yourdfpy refuses shapes it does not know, such as PyBullet's
-    `<capsule>`), numbers read as strtod reads them."""
+    `<capsule>`), numbers read as strtod reads them. With a `fixes` list, the forms yourdfpy
+    refuses and the importer reads leniently are read as the importer reads them too, and
+    each fix applied is appended to the list (one phrase each)."""
     import xml.etree.ElementTree as ET
 
     root = ET.parse(path).getroot()
@@ -81,11 +83,32 @@ def _comparable(path: Path) -> bytes:
             for key, text in child.attrib.items():
                 if key in NUMERIC:
                     child.set(key, _strtod(text))
+    if fixes is not None:
+        fixes += _lenient(root)
     return ET.tostring(root, encoding="utf-8")
 
 
-def load_urdf(path: Path):
-    """The URDF's robot as yourdfpy reads it (kinematics and inertials; see `_comparable`)."""
+def _lenient(root) -> list[str]:
+    """Read what the importer reads leniently and yourdfpy refuses (importer/read): a
+    `<robot>` without a name (named after the file by the import), an origin of more than
+    three numbers (its first three, as PyBullet reads it). The fixes applied, one phrase
+    each."""
+    out = []
+    if not root.get("name"):
+        root.set("name", "robot")
+        out.append("the <robot> has no name")
+    long = [e for e in root.iter("origin") for k in ("xyz", "rpy") if len(e.get(k, "").split()) > 3]
+    for element in long:
+        for key in ("xyz", "rpy"):
+            element.set(key, " ".join(element.get(key, "0 0 0").split()[:3]))
+    if long:
+        out.append(f"{len(long)} origins of more than three numbers read as their first three")
+    return out
+
+
+def load_urdf(path: Path, fixes: list[str] | None = None):
+    """The URDF's robot as yourdfpy reads it (kinematics and inertials; see `_comparable`;
+    `fixes`: read leniently, the fixes applied appended to it)."""
     import io
     import logging
 
@@ -93,7 +116,7 @@ def load_urdf(path: Path):
 
     logging.getLogger("yourdfpy").setLevel(logging.ERROR)
     return yourdfpy.URDF.load(
-        io.BytesIO(_comparable(path)),
+        io.BytesIO(_comparable(path, fixes)),
         load_meshes=False,
         build_scene_graph=False,
         build_collision_scene_graph=False,
@@ -112,13 +135,32 @@ def check_source(kit: Kit) -> list[Finding]:
         source = load_urdf(kit.source)
     except Exception as exc:  # yourdfpy raises several types on bad input
         why = " ".join(str(exc).split())[:200]
-        return [*findings, require("source.read", False, f"yourdfpy cannot read the source: {why}")]
+        source, fixes = _read_leniently(kit.source)
+        if source is None:
+            fail = f"yourdfpy cannot read the source: {why}"
+            return [*findings, require("source.read", False, fail)]
+        said = (
+            f"yourdfpy cannot read the source as written ({why}): compared with it read as "
+            f"the importer reads it ({'; '.join(fixes)})"
+        )
+        findings.append(require("source.read", True, said))
     try:
         built = load_urdf(kit.path(kit.urdf))
     except Exception as exc:
         why = " ".join(str(exc).split())[:200]
         return [*findings, require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
     return findings + compare_robots(source, built, Allowed.of(kit.doc))
+
+
+def _read_leniently(path: Path) -> tuple[object | None, list[str]]:
+    """(yourdfpy's robot of the source read leniently, the fixes applied), or (None, ...)
+    when no fix applies or yourdfpy still cannot read it."""
+    fixes: list[str] = []
+    try:
+        robot = load_urdf(path, fixes)
+    except Exception:  # yourdfpy raises several types on bad input
+        return None, fixes
+    return (robot if fixes else None), fixes
 
 
 def _digest(kit: Kit, path: Path) -> list[Finding]:

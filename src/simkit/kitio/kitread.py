@@ -78,8 +78,16 @@ def read_folder_safely(root: Path, read: bool = True) -> dict[str, bytes]:
                     raise SimkitError(f"{root}: {rel} is not a regular file")
                 size = path.stat().st_size
                 total += size
-                if size > MAX_ENTRY or total > MAX_TOTAL:
-                    raise SimkitError(f"{root}: {rel} is over the kit size cap")
+                if size > MAX_ENTRY:
+                    raise SimkitError(
+                        f"{root}: {rel} is over the kit size cap: {size / 2**20:.1f} MiB, "
+                        f"{MAX_ENTRY >> 20} MiB per file"
+                    )
+                if total > MAX_TOTAL:
+                    raise SimkitError(
+                        f"{root}: {rel} is over the kit size cap: the kit holds "
+                        f"{total / 2**20:.1f} MiB with it, {MAX_TOTAL >> 20} MiB in all"
+                    )
                 files[rel] = path.read_bytes() if read else b""
         if len(files) > MAX_ENTRIES:
             raise SimkitError(f"{root}: more than {MAX_ENTRIES} files")

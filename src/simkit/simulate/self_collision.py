@@ -7,6 +7,11 @@ ignored. Depths and distances are in metres, angles in radians.
 
 Why MuJoCo: the issue (12) asks for the contacts a user of the kit would get; MuJoCo's own
 collision pipeline with the MJCF's filters is exactly that.
+
+Mimic joints move with their leaders (the MJCF's equality constraints hold them so): every
+configuration tried sets each follower to `multiplier x leader + offset` (`coupled`), and a
+follower's free range is its leader's, mapped (issue 32: a gripper's knuckle swept alone,
+its mimic partners still, met configurations the mechanism never reaches).
 """
 
 from __future__ import annotations
@@ -27,6 +32,34 @@ TOLERANCE = 0.001
 RANGE_STEP = 0.5 * 3.141592653589793 / 180.0
 #: Random configurations for the self-contact fraction, and their default seed.
 SAMPLES = 10_000
+
+
+#: a mimic joint among the joints tried: (its index, its leader's index, multiplier, offset)
+Mimic = tuple[int, int, float, float]
+
+
+def mimics_of(names: Sequence[str], mimic: dict[str, tuple[str, float, float]]) -> list[Mimic]:
+    """The `Mimic`s of joints `names` from {follower: (leader, multiplier, offset)}; a
+    follower whose leader is not among `names` is left free."""
+    index = {name: i for i, name in enumerate(names)}
+    return [
+        (index[f], index[leader], float(m), float(o))
+        for f, (leader, m, o) in mimic.items()
+        if f in index and leader in index
+    ]
+
+
+def coupled(q: Sequence[float], mimics: Sequence[Mimic]) -> list[float]:
+    """`q` with each mimic joint at multiplier x its leader's value + offset (a leader that
+    follows another is set first: one pass per link of the longest chain)."""
+    out = [float(v) for v in q]
+    for _ in range(len(mimics)):
+        before = list(out)
+        for follower, leader, multiplier, offset in mimics:
+            out[follower] = multiplier * out[leader] + offset
+        if out == before:
+            break
+    return out
 
 
 @dataclass(frozen=True)
@@ -72,9 +105,11 @@ def contacts(model, data, adr: Sequence[int], q: Sequence[float]) -> list[Contac
     return sorted(found, key=lambda c: (-c.depth, c.body1, c.body2))
 
 
-def worst(model, data, adr: Sequence[int], q: Sequence[float]) -> Contact | None:
-    """The deepest self-contact at `q`, or None."""
-    found = contacts(model, data, adr, q)
+def worst(
+    model, data, adr: Sequence[int], q: Sequence[float], mimics: Sequence[Mimic] = ()
+) -> Contact | None:
+    """The deepest self-contact at `q` (mimic joints moved with their leaders), or None."""
+    found = contacts(model, data, adr, coupled(q, mimics) if mimics else q)
     return found[0] if found else None
 
 
@@ -132,6 +167,7 @@ def free_range(
     upper: float,
     step: float = RANGE_STEP,
     tol: float = TOLERANCE,
+    mimics: Sequence[Mimic] = (),
 ) -> tuple[float, float]:
     """Collision-free range (rad) of joint `index` about `home`, the others at home: from home
     toward each limit in `step`s, up to the last angle before a penetration deeper than `tol`
@@ -149,7 +185,7 @@ def free_range(
         last = home[index]
         for k in range(1, count + 1):
             q[index] = limit if k == count else rounded(home[index] + span * k / count)
-            hit = worst(model, data, adr, q)
+            hit = worst(model, data, adr, q, mimics)
             if hit is not None and hit.depth > tol:
                 break
             last = q[index]
@@ -166,6 +202,7 @@ def contact_fraction(
     seed: int,
     samples: int = SAMPLES,
     tol: float = TOLERANCE,
+    mimics: Sequence[Mimic] = (),
 ) -> float:
     """Share of `samples` uniform random configurations inside the limits (numpy generator
     seeded with `seed`) with a self-penetration deeper than `tol`."""
@@ -175,7 +212,7 @@ def contact_fraction(
     qs = rng.uniform(np.asarray(lower), np.asarray(upper), size=(samples, len(adr)))
     hits = 0
     for q in qs:
-        hit = worst(model, data, adr, q)
+        hit = worst(model, data, adr, q, mimics)
         hits += hit is not None and hit.depth > tol
     return hits / samples
 
@@ -189,17 +226,31 @@ def summary(
     seed: int,
     samples: int = SAMPLES,
     tol: float = TOLERANCE,
+    mimics: Sequence[Mimic] = (),
 ) -> dict:
     """robot.json `geometry.self_collision`: clearance at home, each joint's free range about
-    home, and the self-contact fraction of `samples` seeded random configurations."""
+    home, and the self-contact fraction of `samples` seeded random configurations; mimic
+    joints move with their leaders, and a follower's free range is its leader's, mapped."""
     import mujoco
 
     data = mujoco.MjData(model)
     adr = joint_addresses(model, joints)
-    clearance = min_clearance(model, data, adr, home)
+    clearance = min_clearance(model, data, adr, coupled(home, mimics))
+    spans: dict[int, tuple[float, float]] = {}
+    followers = {f: (leader, m, o) for f, leader, m, o in mimics}
+    for i in range(len(joints)):
+        if i not in followers:
+            spans[i] = free_range(
+                model, data, adr, home, i, lower[i], upper[i], tol=tol, mimics=mimics
+            )
+    for _ in range(len(followers)):  # a follower's leader may follow another: in turn
+        for i, (leader, m, o) in followers.items():
+            if i not in spans and leader in spans:
+                ends = sorted(m * end + o for end in spans[leader])
+                spans[i] = (rounded(ends[0]), rounded(ends[1]))
     ranges = []
     for i, name in enumerate(joints):
-        lo, hi = free_range(model, data, adr, home, i, lower[i], upper[i], tol=tol)
+        lo, hi = spans.get(i, (lower[i], upper[i]))  # a mimic cycle: its limits
         ranges.append(
             {
                 "joint": name,
@@ -208,7 +259,7 @@ def summary(
                 "limited_by_collision": bool(lo > lower[i] or hi < upper[i]),
             }
         )
-    fraction = contact_fraction(model, data, adr, lower, upper, seed, samples, tol)
+    fraction = contact_fraction(model, data, adr, lower, upper, seed, samples, tol, mimics)
     return {
         "method": "MuJoCo contacts on the MJCF's collision geoms with its excludes and "
         "parent-child filter; contacts with the world body ignored",
@@ -233,4 +284,6 @@ def run(kit_dir: Path, robot: Robot) -> dict:
     upper = [math.pi if j.upper is None else rounded(j.upper) for j in moving]
     poses = dict(robot.poses)
     home = [rounded(v) for v in poses["home"]] if "home" in poses else [0.0] * len(moving)
-    return summary(model, [j.name for j in moving], lower, upper, home, robot.seed)
+    names = [j.name for j in moving]
+    mimics = mimics_of(names, {j.name: j.mimic for j in moving if j.mimic is not None})
+    return summary(model, names, lower, upper, home, robot.seed, mimics=mimics)

@@ -16,12 +16,18 @@ that lowers the summed excess over `AIM` most (the arm hangs, or folds), nearest
 value on a tie, never at a limit, never bringing two links closer than the clearance (or
 than at home, where they are closer there) on home.py's model with the visual pieces the
 kit's collision covers (collide.covered_shapes). Where no such move is free, one other joint, above
-them or below, may move too (a torso lift rises so a lowered arm clears the base). Effort
-numbers are never changed.
+them or below, may move too (a torso lift rises so a lowered arm clears the base).
+
+Where no pose the search finds holds (a vertical lift carrying its load wherever it stands,
+an effort far below what the arm weighs), the servo is estimated instead (`underpowered`):
+a joint still over `LIMIT` at the home kept gets twice its static load as its effort, marked
+estimated and reported on one line, so that the kit's hold checks agree with the report
+(issue 32, class 6c). A URDF's effort that holds its home is never changed.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -218,3 +224,23 @@ def _result(search, start, q, ratios, acting) -> tuple[list[float], list[str], s
         if abs(q[i] - start[i]) > 1e-12
     ]
     return [float(f"{v:.6g}") for v in q], changes, why
+
+
+def underpowered(robot) -> list[tuple[str, float, float, float]]:
+    """(joint, static gravity load N m or N, its effort, the estimated effort) of each
+    actuated joint whose load at the spec's home is over `LIMIT` of its effort; the estimate
+    is the load over `AIM` (twice the load), rounded up to three significant digits."""
+    start = collide.posed(robot)[0]
+    if start is None:
+        return []
+    ratios, acting = _loads(robot, Tree.of(robot), start)
+    out = []
+    for ratio, i in zip(ratios, acting, strict=True):
+        if ratio > LIMIT:
+            joint = robot.movable_joints[i]
+            load = float(ratio * joint.effort_peak)
+            step = 10.0 ** (math.floor(math.log10(load / AIM)) - 2)  # three digits, rounded up
+            out.append(
+                (joint.name, load, float(joint.effort_peak), math.ceil(load / AIM / step) * step)
+            )
+    return out

@@ -77,6 +77,24 @@ def home(draft: Draft) -> None:
     held = gravity.held_home(draft.robot(), draft.stage)
     if held is not None:
         draft.set_home(held[:2], held[2])
+    _servos_that_hold(draft)
+
+
+def _servos_that_hold(draft: Draft) -> None:
+    """A joint whose servo still cannot hold home against gravity gets an estimated one that
+    does (gravity.underpowered), one report line each at the joint."""
+    for name, load, effort, estimate in gravity.underpowered(draft.robot()):
+        joint = next(j for j in draft.spec["joints"] if j["name"] == name)
+        joint["effort_peak"] = float(f"{estimate:.3g}")
+        joint["estimated"] = sorted({*joint.get("estimated", []), "effort_peak"})
+        old = next((k for k, v in draft.renames.get("joints", {}).items() if v == name), name)
+        draft.note(
+            f"effort {effort:g} cannot hold home against gravity (its static load {load:.3g} "
+            f"is {100 * load / effort:.0f} % of it; at most {100 * gravity.LIMIT:.0f} % holds): "
+            f"{joint['effort_peak']:g}, twice the load (an estimated servo)",
+            draft.where("joint", old),
+        )
+        draft.changed()
 
 
 def _bolted_home(draft: Draft) -> tuple[list[float], list[str]] | None:

@@ -1,7 +1,8 @@
 """Translate: the read source to the draft's spec (format -> draft), the import's first step.
 
-`to_spec` decides the base from the robot's structure (base.py) unless the user set it,
-turns Y-up COLLADA meshes (up_axis.py), converts links, joints and frames (convert.py with
+`to_spec` drops identical duplicate links and joints and declares an undeclared mounting
+frame (declare.py), decides the base from the robot's structure (base.py) unless the user set
+it, turns Y-up COLLADA meshes (up_axis.py), converts links, joints and frames (convert.py with
 links.py, joints.py, geometry.py, meshes.py, masses.py, solids.py, ball_joints.py), makes
 names legal (names.py), keeps the URDF blocks (blocks.py), refuses what `--strict` refuses,
 and leaves the STEP out when the meshes are too large (step_budget.py).
@@ -17,7 +18,7 @@ from pathlib import Path
 
 from simkit.importer.draft import Draft
 from simkit.importer.read.mjcf import MjcfSource
-from simkit.importer.translate import base, blocks, convert, meshes, mjcf, names
+from simkit.importer.translate import base, blocks, convert, declare, meshes, mjcf, names
 from simkit.importer.translate.step_budget import step_fits
 from simkit.importer.translate.up_axis import turn_y_up
 
@@ -58,6 +59,8 @@ def _from_mjcf(draft: Draft, scratch: Path) -> None:
 
 def _translate(draft: Draft) -> None:
     source, report, options = draft.source, draft.report, draft.options
+    declare.identical_duplicates(source, report)  # an include expanded twice
+    declare.mounting_frame(source, report)  # an undeclared parent above the root
     draft.legged, why = base.decide(source)
     floating = options.floating
     if floating is None:

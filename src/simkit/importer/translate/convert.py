@@ -29,7 +29,7 @@ def tree(source: Source) -> tuple[dict, dict, str]:
         if not name:
             raise source.fail(link, "a link needs a name")
         if name in links:
-            raise source.fail(link, f"link '{name}' is defined twice")
+            raise source.fail(link, f"link '{name}' is defined twice, differently")
         links[name] = link
     if not links:
         raise source.fail(source.root, "no <link> in the robot")
@@ -41,7 +41,7 @@ def tree(source: Source) -> tuple[dict, dict, str]:
     joint_names: set = set()
     for joint in source.root.findall("joint"):
         if joint.get("name") in joint_names:
-            raise source.fail(joint, f"joint '{joint.get('name')}' is defined twice")
+            raise source.fail(joint, f"joint '{joint.get('name')}' is defined twice, differently")
         joint_names.add(joint.get("name"))
         for end in ("parent", "child"):
             tag = joint.find(end)
@@ -161,6 +161,7 @@ def convert(
         spec_joints.append(
             {"name": f"{root}_{joint_type}", "type": joint_type, "parent": spec_root, "child": root}
         )
+    drawn = any(link.find("visual") is not None for link in links.values())
     for link_name in links:  # document order
         if link_name == spec_root:
             continue
@@ -184,6 +185,7 @@ def convert(
                 colours,
                 hull_collision,
                 estimate,
+                volume_mass=not drawn,
             )
         )
         if link_name in by_child:

@@ -109,8 +109,8 @@ def _limits(
             out["upper"] = floats(source, limit, "upper", 1, "0")
             if out["lower"] > out["upper"]:
                 raise source.fail(limit, f"lower ({out['lower']}) is greater than upper")
-    velocity = 0.0 if limit is None else abs(floats(source, limit, "velocity", 1, "0"))
-    if velocity > FIELD_BOUNDS["max_velocity"][1]:  # a placeholder such as 1000: no real limit
+    velocity = 0.0 if limit is None else floats(source, limit, "velocity", 1, "0")
+    if velocity < 0 or velocity > FIELD_BOUNDS["max_velocity"][1]:  # -1, 1000: no real limit
         report.estimated(
             source, element, f"velocity {velocity:g} is a placeholder: {VELOCITY[kind]:g}"
         )
@@ -122,8 +122,8 @@ def _limits(
             report.estimated(source, element, f"no velocity limit: {velocity:g}")
             estimated.append("max_velocity")
     out["max_velocity"] = velocity
-    effort = 0.0 if limit is None else abs(floats(source, limit, "effort", 1, "0"))
-    if effort > FIELD_BOUNDS["effort_peak"][1]:  # a placeholder: treated as no limit
+    effort = 0.0 if limit is None else floats(source, limit, "effort", 1, "0")
+    if effort < 0 or effort > FIELD_BOUNDS["effort_peak"][1]:  # -1, 1e30: no real limit
         report.estimated(source, element, f"effort {effort:g} is a placeholder")
         effort = 0.0
     if effort <= 0:

@@ -130,9 +130,13 @@ def link_spec(
     colours: dict[tuple, str],
     hull_collision: bool = False,
     density: float | None = None,
+    volume_mass: bool = True,
 ) -> dict:
     """The spec dict of one link. `colours` maps rgba -> material name (filled here).
-    `density` (kg/m^3): a massless link gets the mass of its solid at it (masses.py)."""
+    `density` (kg/m^3): a massless link gets the mass of its solid at it (masses.py).
+    `volume_mass`: a link without a visual may take its mass from its collision geometry
+    (False where other links have visuals: such a link's collision geometry is a safety
+    volume around a body, such as a capsule about an arm link, not a body; issue 32)."""
     name = link.get("name")
     spec: dict = {"name": name}
     if has_mass(link) or density is None:
@@ -166,14 +170,20 @@ def link_spec(
             collisions.append(got[0])
             infos.append(got[1])
     solid = visuals
+    weighed = "mass" not in spec and (bool(visuals) or volume_mass)
     if not visuals and collisions:
         solid = collisions
-        report.changed(source, link, "no visual: the collision geometry is the visual solid")
+        report.changed(
+            source,
+            link,
+            "no visual: the collision geometry is the visual solid"
+            + ("" if weighed or "mass" in spec else " (a safety volume: no mass from it)"),
+        )
     used = {s["file"] for s in solid if s["shape"] == "mesh"}
     if any(i.file in used and i.repair == "hull" for i in writer.done.values()):
         spec["estimated"] = [*spec.get("estimated", []), "solid"]
-    if "mass" not in spec:  # massless, its mass estimated from the solid
-        spec.update(_from_solid(source, link, report, solid, writer, density))
+    if "mass" not in spec:  # massless: its mass from its solid, or the placeholder speck
+        spec.update(_from_solid(source, link, report, solid if weighed else [], writer, density))
     if solid:
         spec["solid"] = solid
     if rgba is not None:

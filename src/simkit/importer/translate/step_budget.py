@@ -6,6 +6,11 @@ Open CASCADE 7.8 on a quadruped's knee: 3,478 triangles, 8.2 MB). A robot with 3
 triangles would get a 790 MB STEP that takes minutes to write and re-check, over the kit's
 64 MiB per-file cap. Above `MAX_TRIANGLES` the importer writes `step: false` in the spec and
 says so on one line; the user can set it back to true.
+
+A link whose solid holds a mesh is faceted whole: its primitives too, tessellated as
+derive/solids.py makes them (a sphere at 96 segments is 4,608 triangles, 11 MB of STEP), so
+they are counted (`FACETED`; issue 32: humanoids whose mesh links carry spheres went over the
+cap with their meshes alone under the budget). A link of primitives only is exact in the STEP.
 """
 
 from __future__ import annotations
@@ -18,14 +23,25 @@ import numpy as np
 MAX_TRIANGLES = 20_000
 
 
+#: triangles of each primitive in a faceted link solid (derive/solids.py: 48 segments round,
+#: 96 for a sphere; tests/test_import_step_budget.py holds them to derive's meshes)
+FACETED = {"box": 12, "cylinder": 188, "cone": 188, "capsule": 1248, "sphere": 4608}
+
+
 def visual_triangles(spec: dict, spec_dir: Path) -> int:
-    """Triangles in the binary STLs the spec's link solids use (each file counted per use)."""
+    """Triangles of the spec's faceted link solids: those of the binary STLs they use (each
+    file counted per use), and of the primitives beside a mesh in one solid (`FACETED`)."""
     total = 0
     for link in spec.get("links", []):
-        for shape in link.get("solid", []):
+        shapes = link.get("solid", [])
+        if not any(shape.get("shape") == "mesh" for shape in shapes):
+            continue  # primitives only: exact B-rep faces in the STEP
+        for shape in shapes:
             if shape.get("shape") == "mesh":
                 header = (spec_dir / shape["file"]).read_bytes()[80:84]
                 total += int(np.frombuffer(header, dtype="<u4")[0])
+            else:
+                total += FACETED.get(shape.get("shape"), 0)
     return total
 
 

@@ -71,9 +71,10 @@ def finish(draft: Draft, out_dir: Path) -> Path:
     target = out_dir / f"{name}.yaml"
     new = {item.relative_to(draft.stage) for item in draft.stage.rglob("*") if item.is_file()}
     others = set().union(*(_meshes_of(p) for p in out_dir.glob("*.yaml") if p != target))
-    for old in sorted(_meshes_of(target) - new - others):  # another spec's stay
+    stale = sorted(_meshes_of(target) - new - others)  # another spec's stay
+    publish(draft.stage, out_dir)  # all files whole, or none (output.py): one line naming it
+    for old in stale:  # only once the new spec is in place: a failure changes nothing
         (out_dir / old).unlink(missing_ok=True)
-    publish(draft.stage, out_dir)  # each file whole (output.py), or one line naming it
     return target
 
 

@@ -142,8 +142,12 @@ def _massless(source: Source, add) -> None:
 def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
     """A fixed base bolts the URDF's root link to a root frame (`world`) the URDF lacks."""
     root = spec["root"]
-    if source.root.find(f"link[@name='{_quoted(back.get(root, root))}']") is not None:
+    old = _quoted(back.get(root, root))
+    if source.root.find(f"link[@name='{old}']") is not None:
         return  # the URDF's own massless root link is the kit's root
+    if source.root.find(f"joint/parent[@link='{old}']") is not None:  # translate/declare.py
+        add(f"links.{root}", "added: the frame the URDF mounts the robot on, named, not declared")
+        return
     for joint in spec["joints"]:
         if joint["parent"] == root and joint["type"] == "fixed":
             add(f"links.{root}", "added: the world the fixed base is bolted to")
