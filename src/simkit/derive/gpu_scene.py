@@ -18,12 +18,11 @@ mesh, a cylinder's circumscribed box stands in for it, in that pair only (the in
 where the circumscribed one would touch at a named pose that the cylinder does not). So no
 collider turns into a mesh (MJX compiles one collision function per distinct mesh pair).
 
-Pairs (`contact pairs`): the collider pairs in contact in any of the seeded configurations the
-SRDF's sampling draws (derive/collision_pairs.py), except the link pairs the main MJCF never
-collides (joined by a joint, welded, always in contact). A floating base also stands on a
-floor: the colliders within `FOOT_BAND` of the lowest point at home pair with it, less those
-whose core lies in the convex hull of a neighbour's core on the same link (a plane can never
-reach them first).
+Pairs (`contact pairs`): the collider pairs in contact at a named pose or in any of the seeded
+configurations the SRDF's sampling draws (derive/collision_pairs.py), except the link pairs
+the main MJCF never collides (joined by a joint, welded, always in contact). A floating base
+also meets a floor: every collider pairs with it, less those whose core lies in the convex
+hull of a neighbour's core on the same link (a plane can never reach them first).
 """
 
 from __future__ import annotations
@@ -40,13 +39,10 @@ from simkit.derive.gpu_colliders import (
     mujoco_type,
     piece_vertices,
     sampled_contacts,
-    scratch_xml,
 )
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Robot
 
-#: m: colliders this close above the lowest point at home stand on the floor
-FOOT_BAND = 0.02
 #: solver settings for batched simulation: Newton with few iterations (the issue's measured
 #: Asimov variant: iterations 4, line search 8; MJX's own humanoid uses 1 and 4)
 ITERATIONS = 4
@@ -88,9 +84,9 @@ METHOD = (
     "colliders: the spec's primitives (a cone as the cylinder that covers it; a cylinder's "
     "circumscribed box where it meets a box or a mesh), other pieces with at most "
     f"{MAX_HULL_VERTICES} hull vertices; pairs: the collider pairs in contact in any of "
-    "`samples` configurations drawn as for collision_pairs (seed `seed`), less the pairs the "
-    "main MJCF never collides; floor pairs (floating base): colliders within "
-    f"{FOOT_BAND} m of the lowest point at home whose core no neighbour's covers; "
+    "the named poses and `samples` configurations drawn as for collision_pairs (seed `seed`), "
+    "less the pairs the main MJCF never collides; floor pairs (floating base): every collider "
+    "whose core no same-link neighbour's covers; "
     "contact_slots: MJX slots of the floor pairs plus twice the most in use at once in a "
     f"sampled configuration that penetrates under {TOUCHING_DEPTH} m (MJX max_contact_points "
     f"keeps the deepest), at most pair_slots; njmax: {ROWS_PER_CONTACT} rows a contact plus "
@@ -161,30 +157,6 @@ def peak_slots(kinds: dict[str, str], contacts: list[tuple[float, set]], swaps: 
 # --- the floor: what a floating base stands on ------------------------------------------
 
 
-def _home(robot: Robot) -> np.ndarray:
-    """The home pose (sampled-joint order): the spec's `home`, else zeros."""
-    names = [j.name for j in robot.movable_joints]
-    values = dict(zip(names, dict(robot.poses).get("home", (0.0,) * len(names)), strict=True))
-    return np.array([values.get(n, 0.0) for n, _, _ in sampled_joints(robot)], dtype=float)
-
-
-def _lowest(geom: dict, pos: np.ndarray, mat: np.ndarray, vertices: np.ndarray | None) -> float:
-    """Lowest world z (m) of a collider placed at `pos`, `mat` (MuJoCo's geom frame)."""
-    kind = geom["kind"]
-    if vertices is not None:
-        return float(np.min(vertices[:, 2]))
-    if kind == "sphere":
-        return float(pos[2] - geom["radius"])
-    axis_z = abs(mat[2, 2])
-    if kind == "capsule":
-        return float(pos[2] - axis_z * geom["length"] / 2 - geom["radius"])
-    if kind == "cylinder":
-        radial = geom["radius"] * math.sqrt(max(0.0, 1.0 - axis_z**2))
-        return float(pos[2] - axis_z * geom["length"] / 2 - radial)
-    half = np.asarray(geom["size"]) / 2  # box
-    return float(pos[2] - np.abs(mat[2]) @ half)
-
-
 def _cores(geom: dict) -> np.ndarray:
     """A round collider's core in its link frame: a sphere's centre, a capsule's end points."""
     centre = np.asarray(geom["xyz"], dtype=float)
@@ -231,33 +203,11 @@ def _prune_shadowed(candidates: list[dict]) -> list[dict]:
     return kept
 
 
-def floor_colliders(robot: Robot, geoms: list[dict]) -> list[str]:
-    """Names of the colliders a floating base stands on at home: within `FOOT_BAND` of the
-    lowest point, less the shadowed ones."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_string(scratch_xml(robot, geoms, set()))
-    data = mujoco.MjData(model)
-    names = [j for j, _, _ in sampled_joints(robot)]
-    adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
-    data.qpos[adr] = _home(robot)
-    mujoco.mj_kinematics(model, data)
-    low = {}
-    for geom in geoms:
-        gid = model.geom(geom["name"]).id
-        body = model.geom_bodyid[gid]
-        vertices = None
-        if geom["kind"] == "piece":
-            local = piece_vertices(robot, geom)
-            vertices = local @ data.xmat[body].reshape(3, 3).T + data.xpos[body]
-        low[geom["name"]] = _lowest(
-            geom, data.geom_xpos[gid], data.geom_xmat[gid].reshape(3, 3), vertices
-        )
-    if not low:
-        return []
-    bottom = min(low.values())
-    candidates = [g for g in geoms if low[g["name"]] <= bottom + FOOT_BAND]
-    return sorted(g["name"] for g in _prune_shadowed(candidates))
+def floor_colliders(geoms: list[dict]) -> list[str]:
+    """Names of the colliders a floating base may meet the floor with: every collider, less
+    the shadowed ones. A robot may rest on more than its feet (a quadruped lying on its hips
+    at home), and the GPU scene must stand, fall and lie as the main MJCF does."""
+    return sorted(g["name"] for g in _prune_shadowed(list(geoms)))
 
 
 # --- the plan ---------------------------------------------------------------------------
@@ -291,9 +241,10 @@ def derive_gpu_scene(robot: Robot) -> Robot:
     sampled configuration that only touches (`peak_slots`)."""
     geoms = [g for link in robot.links for g in colliders(link)]
     q = configurations(robot, robot.seed)
-    contacts = sampled_contacts(robot, geoms, q)
+    # the named poses too: a pair in contact where the servos hold the robot must collide
+    contacts = sampled_contacts(robot, geoms, np.vstack([_named_rows(robot), q]))
     pairs = sorted([a, b] for a, b in set().union(*(c for _, c in contacts)))
-    floor = floor_colliders(robot, geoms) if robot.floating_joint is not None else []
+    floor = floor_colliders(geoms) if robot.floating_joint is not None else []
     kinds = {g["name"]: g["kind"] for g in geoms}
     swaps = stand_ins(kinds, pairs)
     for geom in geoms:
