@@ -99,9 +99,12 @@ def _scratch_geom(robot: Robot, asset: ET.Element, body: ET.Element, geom: dict)
     ET.SubElement(body, "geom", attrs)
 
 
-def scratch_xml(robot: Robot, geoms: list[dict], skip: set[tuple[str, str]]) -> str:
+def scratch_xml(
+    robot: Robot, geoms: list[dict], skip: set[tuple[str, str]], floor: float | None = None
+) -> str:
     """MJCF of the colliders on the robot's bodies at their joint origins (a floating base at
-    its spec origin, locked), every link pair but `skip` colliding, the parent filter off."""
+    its spec origin, locked), every link pair but `skip` colliding, the parent filter off;
+    with `floor` (m), also a plane `floor` at the root's z = 0 with that contact margin."""
     root = ET.Element("mujoco", model=f"{robot.name}_gpu_pairs")
     ET.SubElement(root, "compiler", angle="radian", inertiafromgeom="false")
     ET.SubElement(ET.SubElement(root, "option"), "flag", filterparent="disable", gravity="disable")
@@ -109,6 +112,9 @@ def scratch_xml(robot: Robot, geoms: list[dict], skip: set[tuple[str, str]]) -> 
     ET.SubElement(default, "geom", contype="1", conaffinity="1", margin=repr(TOUCH / 2))
     asset = ET.SubElement(root, "asset")
     bodies = {robot.root: ET.SubElement(root, "worldbody")}
+    if floor is not None:
+        plane = {"name": "floor", "type": "plane", "size": "0 0 1", "margin": repr(floor)}
+        ET.SubElement(bodies[robot.root], "geom", plane)
     by_link: dict[str, list[dict]] = {}
     for geom in geoms:
         by_link.setdefault(geom["link"], []).append(geom)

@@ -37,8 +37,10 @@ from simkit.derive.gpu_colliders import (
     MAX_HULL_VERTICES,
     colliders,
     mujoco_type,
+    never_collided,
     piece_vertices,
     sampled_contacts,
+    scratch_xml,
 )
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Robot
@@ -78,12 +80,18 @@ ROWS_PER_CONTACT = 4
 FLOOR = "floor"
 #: m: a sampled configuration penetrating no deeper than this only touches
 TOUCHING_DEPTH = 0.005
+#: hull vertices kept for a piece the robot stands on at home (MJX's guidance against a plane:
+#: about 200; fewer would lower and narrow the feet, and the robot would drift), and how
+#: close to the floor (m) a collider counts as standing on it
+STANDING_HULL_VERTICES = 200
+STANDING_MARGIN = 0.01
 
 
 METHOD = (
     "colliders: the spec's primitives (a cone as the cylinder that covers it; a cylinder's "
     "circumscribed box where it meets a box or a mesh), other pieces with at most "
-    f"{MAX_HULL_VERTICES} hull vertices; pairs: the collider pairs in contact in any of "
+    f"{MAX_HULL_VERTICES} hull vertices ({STANDING_HULL_VERTICES} for pieces within "
+    f"{STANDING_MARGIN} m of the floor at home); pairs: the collider pairs in contact in any of "
     "the named poses and `samples` configurations drawn as for collision_pairs (seed `seed`), "
     "less the pairs the main MJCF never collides; floor pairs (floating base): every collider "
     "whose core no same-link neighbour's covers; "
@@ -203,6 +211,30 @@ def _prune_shadowed(candidates: list[dict]) -> list[dict]:
     return kept
 
 
+def standing_colliders(robot: Robot, geoms: list[dict]) -> set[str]:
+    """Colliders within `STANDING_MARGIN` of the floor at home (a floating base at its spec
+    origin, which the importer and the seeds put on the floor)."""
+    import mujoco
+
+    xml = scratch_xml(robot, geoms, never_collided(robot), floor=STANDING_MARGIN)
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    names = [j for j, _, _ in sampled_joints(robot)]
+    adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
+    values = dict(robot.poses).get("home")
+    movable = [j.name for j in robot.movable_joints]
+    home = dict(zip(movable, values, strict=True)) if values else {}
+    data.qpos[adr] = [home.get(n, 0.0) for n in names]
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_collision(model, data)
+    floor = model.geom("floor").id
+    return {
+        model.geom(int(b if a == floor else a)).name
+        for a, b in data.contact.geom[: data.ncon]
+        if floor in (a, b)
+    }
+
+
 def floor_colliders(geoms: list[dict]) -> list[str]:
     """Names of the colliders a floating base may meet the floor with: every collider, less
     the shadowed ones. A robot may rest on more than its feet (a quadruped lying on its hips
@@ -244,15 +276,18 @@ def derive_gpu_scene(robot: Robot) -> Robot:
     # the named poses too: a pair in contact where the servos hold the robot must collide
     contacts = sampled_contacts(robot, geoms, np.vstack([_named_rows(robot), q]))
     pairs = sorted([a, b] for a, b in set().union(*(c for _, c in contacts)))
-    floor = floor_colliders(geoms) if robot.floating_joint is not None else []
+    floating = robot.floating_joint is not None
+    floor = floor_colliders(geoms) if floating else []
+    standing = standing_colliders(robot, geoms) if floating else set()
     kinds = {g["name"]: g["kind"] for g in geoms}
     swaps = stand_ins(kinds, pairs)
     for geom in geoms:
         if geom["name"] in swaps:
             geom["box_for"] = swaps[geom["name"]]
             geom["box_half"] = geom["radius"]
-        if geom["kind"] == "piece" and len(piece_vertices(robot, geom)) > MAX_HULL_VERTICES:
-            geom["maxhullvert"] = MAX_HULL_VERTICES
+        cap = STANDING_HULL_VERTICES if geom["name"] in standing else MAX_HULL_VERTICES
+        if geom["kind"] == "piece" and len(piece_vertices(robot, geom)) > cap:
+            geom["maxhullvert"] = cap
     inscribed = inscribed_stand_ins(robot, geoms, swaps) if swaps else set()
     for geom in geoms:
         if geom["name"] in inscribed:
