@@ -23,7 +23,7 @@ from dataclasses import replace
 import numpy as np
 
 from simkit.model.kinematics import contracted_pairs, jointed_pairs, quat_wxyz, rpy_matrix
-from simkit.model.robot import Link, Robot, Shape
+from simkit.model.robot import Joint, Link, Robot, Shape
 
 SAMPLES = 10_000
 #: configurations (the first of the sampled ones) a pair's contact is counted in for "Always"
@@ -103,6 +103,22 @@ def _mesh_geom(asset: ET.Element, body: ET.Element, name: str, vertices: np.ndar
     ET.SubElement(body, "geom", type="mesh", mesh=name)
 
 
+def scratch_body(parent: ET.Element, joint: Joint) -> ET.Element:
+    """A scratch model's body for `joint`'s child at the joint origin, unit mass, with a hinge
+    or slide; a fixed or floating joint gets a slide that is never moved (so MuJoCo welds no
+    two bodies together)."""
+    quat = quat_wxyz(rpy_matrix(joint.rpy))
+    body = ET.SubElement(parent, "body", name=joint.child, pos=_text(joint.xyz), quat=_text(quat))
+    ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
+    if joint.type in ("revolute", "continuous"):
+        ET.SubElement(body, "joint", name=joint.name, type="hinge", axis=_text(joint.axis))
+    elif joint.type == "prismatic":
+        ET.SubElement(body, "joint", name=joint.name, type="slide", axis=_text(joint.axis))
+    else:
+        ET.SubElement(body, "joint", name=f"{joint.name}_locked", type="slide")
+    return body
+
+
 def collision_model_xml(robot: Robot, skip: list[tuple[str, str]] = (), margin: float = 0.0) -> str:
     """MJCF of the links' collision geometry, every link pair able to touch except `skip`:
     every body has a degree of freedom (fixed joints get a locked slide) so MuJoCo welds none
@@ -120,18 +136,7 @@ def collision_model_xml(robot: Robot, skip: list[tuple[str, str]] = (), margin: 
     bodies = {robot.root: ET.SubElement(root, "worldbody")}
     for joint in robot.joints:
         link = robot.link(joint.child)
-        quat = quat_wxyz(rpy_matrix(joint.rpy))
-        body = ET.SubElement(
-            bodies[joint.parent], "body", name=link.name, pos=_text(joint.xyz), quat=_text(quat)
-        )
-        bodies[link.name] = body
-        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
-        if joint.type in ("revolute", "continuous"):
-            ET.SubElement(body, "joint", name=joint.name, type="hinge", axis=_text(joint.axis))
-        elif joint.type == "prismatic":
-            ET.SubElement(body, "joint", name=joint.name, type="slide", axis=_text(joint.axis))
-        else:  # held at 0 by never being moved
-            ET.SubElement(body, "joint", name=f"{joint.name}_locked", type="slide")
+        body = bodies[link.name] = scratch_body(bodies[joint.parent], joint)
         if link.collision_primitives:
             for shape in link.collision_primitives:
                 _shape_geom(body, shape)

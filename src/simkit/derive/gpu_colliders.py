@@ -10,7 +10,12 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from simkit.derive.collision import MAX_PIECES
-from simkit.derive.collision_pairs import follow_mimics, sampled_joints, welded_pairs
+from simkit.derive.collision_pairs import (
+    follow_mimics,
+    sampled_joints,
+    scratch_body,
+    welded_pairs,
+)
 from simkit.derive.solids import is_convex_union
 from simkit.model.kinematics import jointed_pairs, quat_wxyz, rpy_matrix
 from simkit.model.robot import Link, Robot, Shape
@@ -119,18 +124,7 @@ def scratch_xml(
     for geom in geoms:
         by_link.setdefault(geom["link"], []).append(geom)
     for joint in robot.joints:
-        quat = quat_wxyz(rpy_matrix(joint.rpy))
-        body = ET.SubElement(
-            bodies[joint.parent], "body", name=joint.child, pos=_text(joint.xyz), quat=_text(quat)
-        )
-        bodies[joint.child] = body
-        ET.SubElement(body, "inertial", pos="0 0 0", mass="1", diaginertia="1 1 1")
-        if joint.type in ("revolute", "continuous"):
-            ET.SubElement(body, "joint", name=joint.name, type="hinge", axis=_text(joint.axis))
-        elif joint.type == "prismatic":
-            ET.SubElement(body, "joint", name=joint.name, type="slide", axis=_text(joint.axis))
-        else:  # fixed and floating: held at the origin
-            ET.SubElement(body, "joint", name=f"{joint.name}_locked", type="slide")
+        body = bodies[joint.child] = scratch_body(bodies[joint.parent], joint)
         for geom in by_link.get(joint.child, []):
             _scratch_geom(robot, asset, body, geom)
     contact = ET.SubElement(root, "contact")

@@ -75,7 +75,8 @@ def _assets(robot: Robot, mujoco: ET.Element) -> None:
     mjcf_world.assets(robot, asset)
 
 
-def _geoms(body: ET.Element, link: Link) -> None:
+def visual_geom(body: ET.Element, link: Link) -> None:
+    """The link's visual `<geom>` (its solid's mesh), where it has a solid."""
     if link.solid is not None:
         sub(
             body,
@@ -87,6 +88,10 @@ def _geoms(body: ET.Element, link: Link) -> None:
                 "material": link.material,
             },
         )
+
+
+def _geoms(body: ET.Element, link: Link) -> None:
+    visual_geom(body, link)
     if link.collision_primitives or link.collision_method == "primitives":
         # one primitive: `LINK_collision`, the Asimov page's name (left_knee_link_collision)
         single = len(link.collision_primitives) == 1

@@ -70,17 +70,7 @@ def _geom_writer(robot: Robot):
         by_link.setdefault(geom["link"], []).append(geom)
 
     def write(body: ET.Element, link: Link) -> None:
-        if link.solid is not None:
-            sub(
-                body,
-                "geom",
-                {
-                    "name": f"{link.name}_visual",
-                    "class": "visual",
-                    "mesh": mjcf.mesh_name(link.name),
-                    "material": link.material,
-                },
-            )
+        mjcf.visual_geom(body, link)
         for geom in by_link.get(link.name, []):
             _collider(body, geom)
 

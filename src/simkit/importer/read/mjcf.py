@@ -51,28 +51,32 @@ class MjcfSource(Source):
     listed: list[tuple[str, str]] = field(default_factory=list)
 
 
-def is_mjcf(path: Path) -> bool:
-    """Whether the file's root element is `<mujoco>` (read from its first 64 KiB)."""
-    try:
-        with path.open("rb") as handle:
-            head = handle.read(65536)
-    except OSError:
-        return False
-    head = re.sub(rb"<!--.*?-->", b"", head, flags=re.S)
-    head = re.sub(rb"<\?.*?\?>", b"", head, flags=re.S)
-    return re.match(rb"\s*<\s*mujoco[\s>/]", head) is not None
-
-
-def model_name(path: Path) -> str | None:
-    """The `<mujoco model="...">` attribute (from the file's first 64 KiB), or None: the
-    name a model's authors gave it, where robot collections name every file `robot.xml`."""
+def _head(path: Path) -> bytes | None:
+    """The file's first 64 KiB without comments and processing instructions, or None."""
     try:
         with path.open("rb") as handle:
             head = handle.read(65536)
     except OSError:
         return None
     head = re.sub(rb"<!--.*?-->", b"", head, flags=re.S)
-    found = re.search(rb"<\s*mujoco\b[^>]*?\bmodel\s*=\s*([\"'])([^\"']*)\1", head)
+    return re.sub(rb"<\?.*?\?>", b"", head, flags=re.S)
+
+
+def is_mjcf(path: Path) -> bool:
+    """Whether the file's root element is `<mujoco>` (read from its first 64 KiB)."""
+    head = _head(path)
+    return head is not None and re.match(rb"\s*<\s*mujoco[\s>/]", head) is not None
+
+
+def model_name(path: Path) -> str | None:
+    """The `<mujoco model="...">` attribute (from the file's first 64 KiB), or None: the
+    name a model's authors gave it, where robot collections name every file `robot.xml`."""
+    head = _head(path)
+    found = (
+        None
+        if head is None
+        else re.search(rb"<\s*mujoco\b[^>]*?\bmodel\s*=\s*([\"'])([^\"']*)\1", head)
+    )
     return found.group(2).decode("utf-8", "replace") if found else None
 
 
