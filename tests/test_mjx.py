@@ -116,6 +116,21 @@ def test_a_gpu_scene_that_stands_differently_fails(seed_kits, tmp_path):
     assert any("end where the main MJCF's do" in line for line in failures), failures
 
 
+def test_a_broad_phase_that_drops_touching_pairs_fails(seed_kits, tmp_path):
+    """max_geom_pairs 1 in the file and robot.json alike: the check's own seeded draw finds a
+    configuration that touches through a pair MJX would then never narrow-phase."""
+    kit = _copy(seed_kits, "rosie_1000", tmp_path)
+    path = kit / "mjcf" / "rosie_1000_mjx.xml"
+    text, count = re.subn(r'(name="max_geom_pairs" data=")\d+', r"\g<1>1", path.read_text())
+    assert count == 1
+    path.write_text(text)
+    doc = json.loads((kit / "robot.json").read_text())
+    doc["gpu_scene"]["max_geom_pairs"] = 1
+    (kit / "robot.json").write_text(json.dumps(doc))
+    failures = _failures(kit)
+    assert any("broad phase keeps every pair" in line for line in failures), failures
+
+
 @needs_mjx
 def test_the_kit_mjx_demo_runs(seed_kits):
     """examples/mjx_demo.py, the document's snippet made runnable, with the batch size as an

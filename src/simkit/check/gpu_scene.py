@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from simkit.check.findings import Finding, compare, require
+from simkit.check.gpu_broadphase import check_broadphase, numeric
 from simkit.check.kit import Kit
 
 CHECK = "gpu_scene"
@@ -106,17 +107,10 @@ def _only_pairs(gpu, doc: dict) -> list[Finding]:
         ),
         compare(CHECK, "njmax as robot.json states", stated.get("njmax", -1), gpu.njmax, 0, ""),
     ]
-    cap = _numeric(gpu, "max_contact_points")
+    cap = numeric(gpu, "max_contact_points")
     if cap is not None:
         out.append(compare(CHECK, "max_contact_points", stated.get("contact_slots"), cap, 0, ""))
     return out
-
-
-def _numeric(model, name: str) -> int | None:
-    import mujoco
-
-    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name)
-    return None if index < 0 else int(model.numeric_data[model.numeric_adr[index]])
 
 
 def held_positions(model, qpos, ctrl, seconds: float = HOLD_SECONDS) -> np.ndarray:
@@ -168,5 +162,6 @@ def check_gpu_scene(kit: Kit) -> list[Finding]:
         out
         + _same_physics(reference, gpu)
         + _only_pairs(gpu, kit.doc)
+        + check_broadphase(gpu, kit.doc)
         + _holds_alike(reference, gpu)
     )

@@ -33,6 +33,7 @@ from dataclasses import replace
 import numpy as np
 
 from simkit.derive.collision_pairs import configurations, sampled_joints
+from simkit.derive.gpu_broadphase import max_geom_pairs, mjx_pairs
 from simkit.derive.gpu_colliders import (
     MAX_HULL_VERTICES,
     colliders,
@@ -45,10 +46,11 @@ from simkit.derive.gpu_colliders import (
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Robot
 
-#: solver settings for batched simulation: Newton with few iterations (the issue's measured
-#: Asimov variant: iterations 4, line search 8; MJX's own humanoid uses 1 and 4)
-ITERATIONS = 4
-LS_ITERATIONS = 8
+#: solver settings for batched simulation: Newton with few iterations. MJX's own humanoid uses
+#: 1 and 4; with 1, Asimov's GPU scene held its stance 18 mm away from the main MJCF's after
+#: 2 s (over the check's 5 mm), with 2 it holds within 0.3 mm (docs/gpu.md)
+ITERATIONS = 2
+LS_ITERATIONS = 4
 #: contact slots a pair takes in MJX (mujoco-mjx 3.17 collision functions' `ncon`), by the
 #: two MuJoCo geom types in MuJoCo's order; `mesh` stands for pieces
 MJX_CONTACTS = {
@@ -98,7 +100,10 @@ METHOD = (
     "contact_slots: MJX slots of the floor pairs plus twice the most in use at once in a "
     f"sampled configuration that penetrates under {TOUCHING_DEPTH} m (MJX max_contact_points "
     f"keeps the deepest), at most pair_slots; njmax: {ROWS_PER_CONTACT} rows a contact plus "
-    "joint limits, friction loss and mimics"
+    "joint limits, friction loss and mimics; max_geom_pairs (MJX's broad phase, absent: no "
+    "cull): the most pairs of one MJX group whose bounding spheres come within 5 mm in a named "
+    "pose or a sampled configuration that only touches (pairs within 5 mm); broadphase_rank: "
+    "the worst rank of a touching pair seen there"
 )
 
 
@@ -274,7 +279,8 @@ def derive_gpu_scene(robot: Robot) -> Robot:
     geoms = [g for link in robot.links for g in colliders(link)]
     q = configurations(robot, robot.seed)
     # the named poses too: a pair in contact where the servos hold the robot must collide
-    contacts = sampled_contacts(robot, geoms, np.vstack([_named_rows(robot), q]))
+    rows = np.vstack([_named_rows(robot), q])
+    contacts = sampled_contacts(robot, geoms, rows)
     pairs = sorted([a, b] for a, b in set().union(*(c for _, c in contacts)))
     floating = robot.floating_joint is not None
     floor = floor_colliders(geoms) if floating else []
@@ -292,6 +298,10 @@ def derive_gpu_scene(robot: Robot) -> Robot:
     for geom in geoms:
         if geom["name"] in inscribed:
             geom["box_half"] = geom["radius"] / math.sqrt(2)
+    boxes = [stand_in_box(g, g["box_half"]) for g in geoms if g["name"] in swaps]
+    cull, rank = max_geom_pairs(
+        robot, geoms + boxes, mjx_pairs(pairs, kinds, swaps), rows, TOUCHING_DEPTH
+    )
     standing = sum(pair_slots(kinds, FLOOR, g) for g in floor)
     every = standing + sum(pair_slots(kinds, a, b, swaps) for a, b in pairs)
     peak = peak_slots(kinds, contacts, swaps)
@@ -303,6 +313,8 @@ def derive_gpu_scene(robot: Robot) -> Robot:
         "pair_slots": every,
         "touching_peak": peak,
         "contact_slots": budget,
+        "max_geom_pairs": cull,
+        "broadphase_rank": rank,
         "nconmax": max(budget, 1),
         "njmax": max(constraint_rows(robot, budget), 1),
         "iterations": ITERATIONS,

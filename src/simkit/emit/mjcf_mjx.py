@@ -142,9 +142,13 @@ def emit(robot: Robot) -> dict[str, bytes]:
     option = {"iterations": num(plan["iterations"]), "ls_iterations": num(plan["ls_iterations"])}
     mujoco = mjcf.head(robot, f"{robot.name}_mjx", file, option)
     sub(mujoco, "size", nconmax=num(plan["nconmax"]), njmax=num(plan["njmax"]))
-    if plan["contact_slots"] < plan["pair_slots"]:
+    capped = plan["contact_slots"] < plan["pair_slots"]
+    if capped or plan.get("max_geom_pairs") is not None:
         custom = sub(mujoco, "custom")
-        sub(custom, "numeric", name="max_contact_points", data=num(plan["contact_slots"]))
+        if capped:
+            sub(custom, "numeric", name="max_contact_points", data=num(plan["contact_slots"]))
+        if plan.get("max_geom_pairs") is not None:
+            sub(custom, "numeric", name="max_geom_pairs", data=num(plan["max_geom_pairs"]))
     mjcf.defaults(robot, mujoco)
     _assets(robot, mujoco)
     worldbody = mjcf.world(robot, mujoco, _geom_writer(robot))

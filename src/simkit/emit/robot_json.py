@@ -245,6 +245,9 @@ def gpu_scene(robot: Robot) -> dict | None:
         "seed": plan["seed"],
         "samples": plan["samples"],
     }
+    if plan.get("max_geom_pairs") is not None:
+        out["max_geom_pairs"] = plan["max_geom_pairs"]
+        out["broadphase_rank"] = plan["broadphase_rank"]
     if "note" in plan:
         out["note"] = plan["note"]
     return out

@@ -1,0 +1,140 @@
+"""The GPU scene's MJX broad phase keeps every pair that touches (issue 30).
+
+MJX's custom numeric `max_geom_pairs` = k keeps, in each group of pairs with the same two geom
+types, the k pairs whose bounding spheres are nearest, and never narrow-phases the rest. This
+check reads the written GPU scene, draws its own seeded configurations within the joint limits
+(followers of joint equalities placed by their polynomial; a floating base where keyframe 0
+puts it), and in each configuration that only touches (no pair deeper than `DEPTH`) requires
+every pair in contact to rank within k of its group. The derive step chose k from other
+samples (the SRDF's); this is an independent draw of the same space.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simkit.check.findings import Finding, compare, require
+
+CHECK = "gpu_scene"
+#: seeded configurations drawn, and the draw's seed
+SAMPLES = 2000
+SEED = 30
+#: m: a configuration with a pair deeper than this is one a servo never reaches; pairs closer
+#: than `NEAR` count as in contact (a touch lies between two draws)
+DEPTH = 0.005
+NEAR = 0.005
+#: rad, m: the draw's range for a joint without limits
+UNLIMITED = np.pi
+
+
+def numeric(model, name: str) -> int | None:
+    """The model's custom numeric `name`, or None."""
+    import mujoco
+
+    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name)
+    return None if index < 0 else int(model.numeric_data[model.numeric_adr[index]])
+
+
+def _groups(model) -> dict[tuple, list[int]]:
+    """Explicit pair indices by their two geom types, planes and height fields left out (MJX
+    never culls those)."""
+    import mujoco
+
+    exempt = {int(mujoco.mjtGeom.mjGEOM_PLANE), int(mujoco.mjtGeom.mjGEOM_HFIELD)}
+    out: dict[tuple, list[int]] = {}
+    for i in range(model.npair):
+        pair = (model.pair_geom1[i], model.pair_geom2[i])
+        types = tuple(sorted(int(model.geom_type[g]) for g in pair))
+        if not set(types) & exempt:
+            out.setdefault(types, []).append(i)
+    return out
+
+
+def configurations(model, samples: int, seed: int) -> np.ndarray:
+    """Keyframes, then `samples` seeded joint positions within limits (qpos rows); free and
+    ball joints stay at keyframe 0, joint-equality followers follow their leaders."""
+    import mujoco
+
+    base = model.key_qpos[0].copy() if model.nkey else model.qpos0.copy()
+    rng = np.random.default_rng(seed)
+    rows = np.repeat(base[None, :], samples, axis=0)
+    moving = {int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)}
+    for j in range(model.njnt):
+        if int(model.jnt_type[j]) not in moving:
+            continue
+        low, high = model.jnt_range[j] if model.jnt_limited[j] else (-UNLIMITED, UNLIMITED)
+        rows[:, model.jnt_qposadr[j]] = rng.uniform(low, high, samples)
+    for e in range(model.neq):
+        if int(model.eq_type[e]) == int(mujoco.mjtEq.mjEQ_JOINT) and model.eq_obj2id[e] >= 0:
+            a, b = (model.jnt_qposadr[model.eq_obj1id[e]], model.jnt_qposadr[model.eq_obj2id[e]])
+            c = model.eq_data[e, :5]
+            x = rows[:, b] - model.qpos0[b]
+            rows[:, a] = model.qpos0[a] + c[0] + c[1] * x + c[2] * x**2 + c[3] * x**3 + c[4] * x**4
+    return np.vstack([model.key_qpos, rows]) if model.nkey else rows
+
+
+def _ranks(model, data, groups: dict[tuple, list[int]], touching: set[int]) -> int:
+    """The worst rank by bounding-sphere distance, within its group, of a touching pair."""
+    worst = 0
+    for members in groups.values():
+        ids = np.array([(model.pair_geom1[i], model.pair_geom2[i]) for i in members])
+        xpos, rbound = data.geom_xpos, model.geom_rbound
+        gap = np.linalg.norm(xpos[ids[:, 0]] - xpos[ids[:, 1]], axis=1) - rbound[ids].sum(axis=1)
+        for k, i in enumerate(members):
+            if i in touching:
+                worst = max(worst, int(np.count_nonzero(gap <= gap[k])))
+    return worst
+
+
+def worst_rank(model, samples: int = SAMPLES, seed: int = SEED) -> int:
+    """The worst rank of a pair in contact over the keyframes and the seeded draw."""
+    import copy
+
+    import mujoco
+
+    model = copy.deepcopy(model)
+    model.pair_margin[:] = NEAR
+    data = mujoco.MjData(model)
+    groups = _groups(model)
+    index = {
+        frozenset((int(model.pair_geom1[i]), int(model.pair_geom2[i]))): i
+        for members in groups.values()
+        for i in members
+    }
+    worst = 0
+    for row in configurations(model, samples, seed) if index else []:
+        data.qpos[:] = row
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        contacts = data.contact[: data.ncon] if data.ncon else None
+        if contacts is None or (-contacts.dist > DEPTH).any():
+            continue
+        touching = {index.get(frozenset(int(g) for g in pair)) for pair in contacts.geom}
+        touching.discard(None)
+        if touching:
+            worst = max(worst, _ranks(model, data, groups, touching))  # type: ignore[arg-type]
+    return worst
+
+
+def check_broadphase(gpu, doc: dict) -> list[Finding]:
+    """`max_geom_pairs` is robot.json's, and keeps every pair the draw finds in contact."""
+    stated = (doc.get("gpu_scene") or {}).get("max_geom_pairs")
+    cull = numeric(gpu, "max_geom_pairs")
+    out = [
+        compare(
+            CHECK,
+            "max_geom_pairs as robot.json states",
+            -1 if stated is None else stated,
+            -1 if cull is None else cull,
+            0,
+            "",
+        )
+    ]
+    if cull is None:
+        return out
+    worst = worst_rank(gpu)
+    message = (
+        f"MJX's broad phase keeps every pair in contact: worst rank {worst} of max_geom_pairs "
+        f"{cull} over the keyframes and {SAMPLES} seeded configurations that only touch"
+    )
+    return [*out, require(CHECK, worst <= cull, message)]
