@@ -1,4 +1,5 @@
-"""`usd/NAME.usda`, the entry point: the interface layer of Isaac Sim's robot asset structure.
+"""The interface layer of Isaac Sim's robot asset structure, written twice over one set of
+payloads: `usd/NAME/NAME.usda` (the Isaac asset) and `usd/NAME.usda` (the kit's entry point).
 Its default prim `/NAME` (kind component) references `payloads/base.usda` and holds the variant
 set `Physics`: "none" (geometry only), "physics" (UsdPhysics: `physics.usda`, for any USD
 physics reader, Newton included) and "physx" (the default: `physics.usda` with `physx.usda` on
@@ -67,8 +68,8 @@ def metadata(robot: Robot) -> dict:
     }
 
 
-def interface_text(robot: Robot) -> str:
-    """The entry layer's text."""
+def interface_text(robot: Robot, payloads: str = "./payloads") -> str:
+    """An interface layer's text; `payloads` is the payload folder relative to the layer."""
     from pxr import Kind, Sdf, Usd
 
     name = prim_name(robot.name)
@@ -81,8 +82,8 @@ def interface_text(robot: Robot) -> str:
     variants.SetVariantSelection(DEFAULT_VARIANT)
     del stage
     spec = layer.GetPrimAtPath(f"/{name}")
-    spec.referenceList.Prepend(Sdf.Reference("./payloads/base.usda"))
+    spec.referenceList.Prepend(Sdf.Reference(f"{payloads}/base.usda"))
     for variant, files in VARIANTS.items():
-        payloads = spec.variantSets[VARIANT_SET].variants[variant].primSpec.payloadList
-        payloads.prependedItems = [Sdf.Payload(f"./payloads/{file}") for file in files]
+        arcs = spec.variantSets[VARIANT_SET].variants[variant].primSpec.payloadList
+        arcs.prependedItems = [Sdf.Payload(f"{payloads}/{file}") for file in files]
     return export(layer)
