@@ -2,7 +2,9 @@
 newest version, required and optional neutral features, FET_031 and FET_033) and the Isaac
 tier's robot features (robot core, driven joints, composition, robot materials), run by
 usd-validation-nvidia with physx-usd-schemas and Isaac Sim's robot schema (tests/simready_check.py).
-Every failure and checker error is reported with its rule and prim."""
+The Isaac asset usd/NAME/NAME.usda passes the whole set; its twin, the entry point
+usd/NAME.usda, passes all but RC.003 (ENTRY_EXEMPT). Every failure and checker error is
+reported with its rule and prim."""
 
 from __future__ import annotations
 
