@@ -58,9 +58,9 @@ def one(path: Path, out: Path, wanted: list[str]) -> tuple[dict, list[str]]:
         return row, []
     doc = json.loads((kits[0] / "robot.json").read_text())
     name = doc["name"]
-    row["base"] = "floating" if any(j["type"] == "floating" for j in doc["joints"]) else "fixed"
+    row["base"] = "floating" if doc.get("floating_base") else "fixed"
     row["links"] = str(len(doc["links"]))
-    row["joints"] = str(sum(j["type"] not in ("fixed", "floating") for j in doc["joints"]))
+    row["joints"] = str(len(doc["joints"]))  # robot.json lists movable joints only
     row["checks"] = "pass" if built.returncode == 0 else "FAIL"
     asset = validate(kits[0] / "usd" / name / f"{name}.usda", wanted)
     entry = validate(kits[0] / "usd" / f"{name}.usda", wanted)
