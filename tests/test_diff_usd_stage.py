@@ -8,8 +8,9 @@ import shutil
 from pathlib import Path
 
 from simkit.diff import diff_kits
+from simkit.kitio import layout
 
-PHYSICS = Path("usd") / "payloads" / "physics.usda"
+PHYSICS = Path(layout.usd_payload("ecn_2r", "physics.usda"))
 
 
 def _copy(kit: Path, tmp_path: Path) -> Path:
