@@ -35,6 +35,7 @@ from simkit.check.usd_layout import (
     robot_schema_findings,
     thumbnail_findings,
 )
+from simkit.check.usd_mimic import follower_servo, followers
 from simkit.kitio import layout
 
 #: USD stores masses, inertia, joint frames and drive gains as 32-bit floats (about 7
@@ -126,28 +127,6 @@ def _to_welded(mj, child: int, parent: str, joint: UsdJoint) -> bool:
     return body > 0 and int(mj.body_weldid[body]) == 0
 
 
-def _followers(mj) -> dict[int, tuple[int, float]]:
-    """{follower joint: (leader joint, offset)} of the MJCF's joint equalities. The USD couples
-    a hinge follower by PhysxMimicJointAPI alone (no drive, not even its passive damping);
-    PhysX does not enforce a linear mimic, so a slide follower is driven by its leader's servo,
-    aimed at the offset (m) (docs/usd.md)."""
-    out = {}
-    for e in range(mj.neq):
-        follower, leader = int(mj.eq_obj1id[e]), int(mj.eq_obj2id[e])
-        if mj.eq_type[e] == mujoco.mjtEq.mjEQ_JOINT and leader >= 0:
-            out[follower] = (leader, float(mj.eq_data[e, 0]))
-    return out
-
-
-def _act_follower(mj, jid: int, follows: dict, actuated: dict) -> tuple[int, float] | None:
-    """(leader's actuator, offset m) of a slide follower without a servo of its own."""
-    if jid in actuated or jid not in follows:
-        return None
-    if mj.jnt_type[jid] != mujoco.mjtJoint.mjJNT_SLIDE or follows[jid][0] not in actuated:
-        return None
-    return actuated[follows[jid][0]], follows[jid][1]
-
-
 def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str]) -> list[Finding]:
     """Every USD joint joins the MJCF parent and child bodies at the MJCF body frame; movable
     joints have the MJCF axis, limits and servo. `names`: USD path -> link name."""
@@ -185,7 +164,7 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
         for a in range(mj.nu)
         if mj.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
     }
-    follows = _followers(mj)
+    follows = followers(mj)
     for doc in kit.joints:
         usd = by_name.get(prim_name(doc["name"]))
         if usd is None:
@@ -193,7 +172,7 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
         jid = mj.joint(doc["name"]).id
         axes_exp.append(np.concatenate([mj.jnt_axis[jid], mj.jnt_pos[jid]]))
         axes_act.append(np.concatenate([usd.pose1[:3, :3] @ usd.axis, usd.pose1[:3, 3]]))
-        act, aim, follower = actuated.get(jid), 0.0, _act_follower(mj, jid, follows, actuated)
+        act, aim, follower = actuated.get(jid), 0.0, follower_servo(mj, jid, follows, actuated)
         if follower is not None:  # a slide follower: driven by its leader's servo
             act, aim = follower
         dof, qadr = int(mj.jnt_dofadr[jid]), int(mj.jnt_qposadr[jid])
