@@ -53,6 +53,10 @@ KEY_CHECKS = (
     "usd.physics.drive.stiffness",
     "usd.physics.colliders",
     "usd.physics.xforms",
+    "usd.mujoco.mass",
+    "usd.mujoco.mjc.present",
+    "usd.mujoco.mjc.joints",
+    "usd.mujoco.mjc.actuators",
 )
 
 
@@ -99,7 +103,7 @@ def test_stage_layout(rosie_1000):
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
     layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix in (".usd", ".usda")]
-    assert len(layers) == 8  # the entry, the Isaac asset's interface layer, six payloads
+    assert len(layers) == 9  # the entry, the Isaac asset's interface layer, seven payloads
     for path in sorted(layers):
         text = path.read_text(encoding="utf-8")
         assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
@@ -108,7 +112,7 @@ def test_stage_layout(rosie_1000):
 def test_rebuild_is_byte_identical(rosie_1000):
     robot = model_from_spec("rosie_1000")
     files = usd.emit(robot)
-    assert len(files) == 10  # entry, asset, six payload layers, two thumbnails
+    assert len(files) == 11  # entry, asset, seven payload layers, two thumbnails
     for rel, data in files.items():
         assert (rosie_1000.kit_dir / rel).read_bytes() == data, rel
     assert usd.emit_binary(robot) == usd.emit_binary(robot)
@@ -156,6 +160,18 @@ def test_rebuild_is_byte_identical(rosie_1000):
             '"none" (\n            prepend payload = @./rosie_1000/payloads/physics.usda@\n'
             "        ) {",
             "usd.none.geometry_only",
+        ),
+        (  # the MuJoCo variant's armature off the MJCF's
+            "usd/rosie_1000/payloads/mujoco.usda",
+            "uniform double mjc:armature = ",
+            "uniform double mjc:armature = 1",
+            "usd.mujoco.mjc.joints",
+        ),
+        (  # a servo's gain off the MJCF's
+            "usd/rosie_1000/payloads/mujoco.usda",
+            "uniform double[] mjc:gainPrm = [",
+            "uniform double[] mjc:gainPrm = [1",
+            "usd.mujoco.mjc.actuators",
         ),
         (  # the Isaac asset's interface layer no longer matches the entry point
             "usd/rosie_1000/rosie_1000.usda",

@@ -33,7 +33,8 @@ def test_files_and_layers(tmp_path):
 
     robot = model_from_spec("ecn_2r")
     files = usd.emit(robot)
-    names = {f"usd/ecn_2r/payloads/{n}" for n in (*PAYLOADS, "physics.usda", "physx.usda")}
+    layers = (*PAYLOADS, "physics.usda", "physx.usda", "mujoco.usda")
+    names = {f"usd/ecn_2r/payloads/{n}" for n in layers}
     assert set(files) == {
         "usd/ecn_2r.usda",
         "usd/.thumbs/256x256/ecn_2r.usda.png",
@@ -60,7 +61,7 @@ def test_files_and_layers(tmp_path):
         b"@./payloads/", b"@./ecn_2r/payloads/"
     )
     variants = top.GetVariantSet("Physics")
-    assert variants.GetVariantNames() == ["none", "physics", "physx"]
+    assert variants.GetVariantNames() == ["mujoco", "none", "physics", "physx"]
     assert variants.GetVariantSelection() == "physx"
     assert UsdGeom.GetStageUpAxis(stage) == "Z" and Usd.ModelAPI(top).GetKind() == "component"
     meta = stage.GetRootLayer().customLayerData["SimReady_Metadata"]

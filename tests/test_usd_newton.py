@@ -1,8 +1,9 @@
 """Issue 33: Newton (newton-physics) loads each physics variant of a kit's composed USD stage
 with its own USD importer, on Warp's CPU device: the same bodies and masses, joints, limits
-and drive gains as the MJCF in MuJoCo, and it steps without NaN. The "none" variant gives
-Newton no body. A fixed arm (ecn_2r) and a floating robot with prismatic, continuous and
-fixed joints (tests/specs/usd_mix.yaml).
+and drive gains as the MJCF in MuJoCo, and it steps without NaN. In the "mujoco" variant Newton's
+MjcPhysics resolver also reads the MuJoCo joint armature, friction loss and servos. The "none"
+variant gives Newton no body. A fixed arm (ecn_2r) and a floating robot with prismatic,
+continuous and fixed joints (tests/specs/usd_mix.yaml).
 
 Slow: the first run compiles Newton's Warp kernels for the CPU (about 40 s on two cores; about
 7 s a robot once Warp's kernel cache holds them)."""
@@ -39,8 +40,10 @@ def kit(request, tmp_path_factory) -> tuple[Path, str]:
 
 
 def _load(kit: Path, name: str, variant: str):
-    """Newton's ModelBuilder holding the entry point's stage in `variant`."""
+    """Newton's ModelBuilder holding the entry point's stage in `variant`; the "mujoco"
+    variant is read with Newton's MjcPhysics resolver and its MuJoCo actuator attributes."""
     import newton
+    import newton.usd
     import warp as wp
     from pxr import Usd
 
@@ -49,7 +52,12 @@ def _load(kit: Path, name: str, variant: str):
     with Usd.EditContext(stage, stage.GetSessionLayer()):
         stage.GetDefaultPrim().GetVariantSet("Physics").SetVariantSelection(variant)
     builder = newton.ModelBuilder()
-    builder.add_usd(stage)
+    if variant != "mujoco":
+        builder.add_usd(stage)
+        return builder
+    newton.solvers.SolverMuJoCo.register_custom_attributes(builder)
+    resolvers = [newton.usd.SchemaResolverMjc(), newton.usd.SchemaResolverNewton()]
+    builder.add_usd(stage, schema_resolvers=resolvers)
     return builder
 
 
@@ -57,7 +65,7 @@ def _leaf(label: str) -> str:
     return label.rsplit("/", 1)[-1]
 
 
-@pytest.mark.parametrize("variant", ["physics", "physx"])
+@pytest.mark.parametrize("variant", ["physics", "physx", "mujoco"])
 def test_newton_loads_the_variant_as_the_mjcf(kit, variant):
     import mujoco
     import newton
@@ -88,6 +96,8 @@ def test_newton_loads_the_variant_as_the_mjcf(kit, variant):
             got = [b.joint_target_ke[dof], b.joint_target_kd[dof]]
             np.testing.assert_allclose(got, want, rtol=1e-5)
             assert b.joint_effort_limit[dof] == pytest.approx(mj.actuator_forcerange[a, 1])
+    if variant == "mujoco":
+        _mujoco_values(b, mj, moved, hinges)
     model = b.finalize(device="cpu")
     solver = newton.solvers.SolverMuJoCo(model, use_mujoco_cpu=True)
     state, after, control = model.state(), model.state(), model.control()
@@ -96,6 +106,29 @@ def test_newton_loads_the_variant_as_the_mjcf(kit, variant):
         solver.step(state, after, control, None, 1e-3)
         state, after = after, state
     assert np.isfinite(state.joint_q.numpy()).all() and np.isfinite(state.body_q.numpy()).all()
+
+
+def _mujoco_values(b, mj, moved: dict, hinges: list[int]) -> None:
+    """Newton read the MjcPhysics layer: joint armature and friction loss per DOF, and one
+    MuJoCo actuator per servo with the servo's gains, bias and force range."""
+    for jid in hinges:
+        dof = b.joint_qd_start[moved[mj.joint(jid).name]]
+        got = [b.joint_armature[dof], b.joint_friction[dof]]
+        want = [mj.dof_armature[mj.jnt_dofadr[jid]], mj.dof_frictionloss[mj.jnt_dofadr[jid]]]
+        np.testing.assert_allclose(got, want, rtol=1e-6)
+    attrs = b.custom_attributes
+    targets = [_leaf(x) for x in attrs["mujoco:actuator_target_label"].values]
+    assert sorted(targets) == sorted(mj.joint(int(j)).name for j in mj.actuator_trnid[:, 0])
+    for row, joint in enumerate(targets):
+        a = next(a for a in range(mj.nu) if mj.joint(int(mj.actuator_trnid[a, 0])).name == joint)
+        got = [
+            *attrs["mujoco:actuator_gainprm"].values[row],
+            *attrs["mujoco:actuator_biasprm"].values[row],
+        ]
+        want = [*mj.actuator_gainprm[a], *mj.actuator_biasprm[a]]
+        np.testing.assert_allclose(got, want, rtol=1e-6)
+        forces = attrs["mujoco:actuator_forcerange"].values[row]
+        np.testing.assert_allclose(list(forces), mj.actuator_forcerange[a], rtol=1e-6)
 
 
 def test_newton_finds_no_body_in_the_geometry_only_variant(kit):

@@ -36,6 +36,7 @@ from simkit.check.usd_layout import (
     thumbnail_findings,
 )
 from simkit.check.usd_mimic import follower_servo, followers
+from simkit.check.usd_mjc import MJC_VARIANT, mjc_findings
 from simkit.kitio import layout
 
 #: USD stores masses, inertia, joint frames and drive gains as 32-bit floats (about 7
@@ -321,6 +322,8 @@ def check_usd(kit: Kit) -> list[Finding]:
             findings += geometry_only_findings(stage)
             continue
         found = _physics(kit, stage, top)
+        if name == MJC_VARIANT:
+            found += mjc_findings(stage, top, load_control_mjcf(kit))
         if name != default:
             found = [replace(f, check=f"usd.{name}.{f.check[4:]}") for f in found]
         findings += found

@@ -142,8 +142,8 @@ def geometry_only_findings(stage) -> list[Finding]:
     physics, meshes = [], 0
     for prim in Usd.PrimRange(stage.GetPseudoRoot()):
         meshes += prim.IsA(UsdGeom.Mesh)
-        if str(prim.GetTypeName()).startswith("Physics") or any(
-            s.startswith(("Physics", "Physx", "Isaac")) for s in applied(prim)
+        if str(prim.GetTypeName()).startswith(("Physics", "Mjc")) or any(
+            s.startswith(("Physics", "Physx", "Isaac", "Mjc")) for s in applied(prim)
         ):
             physics.append(str(prim.GetPath()))
     return [

@@ -10,8 +10,8 @@ Files (Z up, metres, kilograms; each layer has a default prim; docs/usd.md):
 - `usd/NAME/payloads/base.usda`: the hierarchy, `/NAME/LINK` Xforms at q = 0 (base.py);
 - `usd/NAME/payloads/geometries.usd`, `instances.usda`, `materials.usda`: meshes, the links'
   visuals and colliders, the materials (geometry.py);
-- `usd/NAME/payloads/physics.usda`, `physx.usda`: UsdPhysics and the PhysX additions
-  (physics.py, physx.py, robot_schema.py);
+- `usd/NAME/payloads/physics.usda`, `physx.usda`, `mujoco.usda`: UsdPhysics, the PhysX and
+  the MuJoCo additions (physics.py, physx.py, mujoco.py, robot_schema.py);
 - `.thumbs/256x256/<layer>.png` beside both interface layers: the thumbnail (thumbnail.py).
 
 Layers are built in memory and serialised with `Sdf.Layer.ExportToString`, so the text holds no
@@ -27,6 +27,7 @@ from simkit.emit.usd.base import base_text
 from simkit.emit.usd.common import axis_frame, place, prim_name
 from simkit.emit.usd.geometry import geometries_text, instances_text, materials_text
 from simkit.emit.usd.interface import DEFAULT_VARIANT, VARIANT_SET, VARIANTS, interface_text
+from simkit.emit.usd.mujoco import mujoco_text
 from simkit.emit.usd.physics import physics_text
 from simkit.emit.usd.physx import physx_text
 from simkit.emit.usd.thumbnail import thumbnail_png
@@ -65,6 +66,7 @@ def layers(robot: Robot) -> dict[str, str]:
         "materials.usda": materials_text(robot),
         "physics.usda": physics_text(robot),
         "physx.usda": physx_text(robot),
+        "mujoco.usda": mujoco_text(robot),
     }
 
 

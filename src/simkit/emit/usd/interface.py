@@ -2,8 +2,9 @@
 payloads: `usd/NAME/NAME.usda` (the Isaac asset) and `usd/NAME.usda` (the kit's entry point).
 Its default prim `/NAME` (kind component) references `payloads/base.usda` and holds the variant
 set `Physics`: "none" (geometry only), "physics" (UsdPhysics: `physics.usda`, for any USD
-physics reader, Newton included) and "physx" (the default: `physics.usda` with `physx.usda` on
-top, for Isaac Sim). The root layer's customLayerData carries the SimReady provenance
+physics reader, Newton included), "physx" (the default: `physics.usda` with `physx.usda` on
+top, for Isaac Sim) and "mujoco" (`physics.usda` with `mujoco.usda`, MuJoCo's MjcPhysics
+schemas, on top). The root layer's customLayerData carries the SimReady provenance
 (`SimReady_Metadata`, rule SR.004) and simkit's own."""
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ VARIANTS = {
     "none": (),
     "physics": ("physics.usda",),
     "physx": ("physx.usda", "physics.usda"),
+    "mujoco": ("mujoco.usda", "physics.usda"),
 }
 DEFAULT_VARIANT = "physx"
 #: Wikidata's "robot" (Q11012): the SimReady category code of every kit
