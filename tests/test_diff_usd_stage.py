@@ -8,8 +8,9 @@ import shutil
 from pathlib import Path
 
 from simkit.diff import diff_kits
+from simkit.kitio import layout
 
-PHYSICS = Path("usd") / "payloads" / "physics.usda"
+PHYSICS = Path(layout.usd_payload("ecn_2r", "physics.usda"))
 
 
 def _copy(kit: Path, tmp_path: Path) -> Path:
@@ -46,6 +47,6 @@ def test_a_physics_change_is_a_row_per_variant(seed_kits, tmp_path):
     rows = [c for c in report.changes if c.kind == "usd"]
     assert {(c.name, c.field, c.old, c.new) for c in rows} == {
         (f"{variant}:/ecn_2r/link_1", "physics:mass", 7.084761, 7.5)
-        for variant in ("physics", "physx")
+        for variant in ("mujoco", "physics", "physx")
     }
     assert str(PHYSICS.as_posix()) in report.changed

@@ -21,6 +21,8 @@ import xml.etree.ElementTree as ET
 import mujoco
 import pytest
 
+from simkit.kitio import layout
+
 pytestmark = pytest.mark.slow
 
 ROBOTS = ["rosie_600", "rosie_1000", "rosie_1400", "ecn_2r", "asimov"]
@@ -64,7 +66,7 @@ def test_rosie_joints_are_j1_to_j6_everywhere(kit_factory, robot):
         assert [j.get("name") for j in group.iter("joint")] == J
     for state in srdf.iter("group_state"):
         assert [j.get("name") for j in state.iter("joint")] == J
-    usd = (kit / "usd" / "payloads" / "physics.usda").read_text()  # the joints' layer
+    usd = (kit / layout.usd_payload(robot, "physics.usda")).read_text()  # the joints' layer
     assert [f'PhysicsRevoluteJoint "{n}"' in usd for n in J] == [True] * 6
     glb = _glb(kit / "glb" / f"{robot}.glb")
     extras = [n["extras"]["joint"]["name"] for n in glb["nodes"] if "joint" in n.get("extras", {})]

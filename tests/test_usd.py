@@ -22,7 +22,8 @@ from simkit.pipeline import build, model_from_spec
 
 SPECS = Path(__file__).resolve().parent / "specs"
 USDA = "usd/rosie_1000.usda"
-PHYSICS = "usd/payloads/physics.usda"
+PHYSICS = "usd/rosie_1000/payloads/physics.usda"
+BASE = "usd/rosie_1000/payloads/base.usda"
 KEY_CHECKS = (
     "usd.validate",
     "usd.stage",
@@ -43,6 +44,8 @@ KEY_CHECKS = (
     "usd.layers",
     "usd.normals",
     "usd.thumbnail",
+    "usd.asset",
+    "usd.asset.thumbnail",
     "usd.robot_schema",
     "usd.none.geometry_only",
     "usd.physics.mass",
@@ -50,6 +53,10 @@ KEY_CHECKS = (
     "usd.physics.drive.stiffness",
     "usd.physics.colliders",
     "usd.physics.xforms",
+    "usd.mujoco.mass",
+    "usd.mujoco.mjc.present",
+    "usd.mujoco.mjc.joints",
+    "usd.mujoco.mjc.actuators",
 )
 
 
@@ -96,7 +103,7 @@ def test_stage_layout(rosie_1000):
     collider = stage.GetPrimAtPath("/rosie_1000/link_2/collisions/collision_00")
     assert UsdPhysics.MeshCollisionAPI(collider).GetApproximationAttr().Get() == "convexHull"
     layers = [p for p in (rosie_1000.kit_dir / "usd").rglob("*") if p.suffix in (".usd", ".usda")]
-    assert len(layers) == 7
+    assert len(layers) == 9  # the entry, the Isaac asset's interface layer, seven payloads
     for path in sorted(layers):
         text = path.read_text(encoding="utf-8")
         assert "/tmp" not in text and "anon:" not in text and str(rosie_1000.kit_dir) not in text
@@ -105,7 +112,7 @@ def test_stage_layout(rosie_1000):
 def test_rebuild_is_byte_identical(rosie_1000):
     robot = model_from_spec("rosie_1000")
     files = usd.emit(robot)
-    assert len(files) == 8  # entry, six payload layers, thumbnail
+    assert len(files) == 11  # entry, asset, seven payload layers, two thumbnails
     for rel, data in files.items():
         assert (rosie_1000.kit_dir / rel).read_bytes() == data, rel
     assert usd.emit_binary(robot) == usd.emit_binary(robot)
@@ -128,29 +135,49 @@ def test_rebuild_is_byte_identical(rosie_1000):
             "usd.limits",
         ),
         (  # a material binding without MaterialBindingAPI: usd-core's validators object
-            "usd/payloads/base.usda",
+            BASE,
             'prepend apiSchemas = ["MaterialBindingAPI"]',
             'prepend apiSchemas = ["NotAnAPI"]',
             "usd.validate",
         ),
         (  # the PhysX variant's layer drops the UsdPhysics payload: caught in that variant
             USDA,
-            "@./payloads/physx.usda@,\n                @./payloads/physics.usda@",
-            "@./payloads/physx.usda@",
+            "@./rosie_1000/payloads/physx.usda@,\n"
+            "                @./rosie_1000/payloads/physics.usda@",
+            "@./rosie_1000/payloads/physx.usda@",
             "usd.bodies",
         ),
         (  # the generic variant composes the PhysX layer alone: that variant's finding fails
             USDA,
-            "payload = @./payloads/physics.usda@",
-            "payload = @./payloads/physx.usda@",
+            "payload = @./rosie_1000/payloads/physics.usda@",
+            "payload = @./rosie_1000/payloads/physx.usda@",
             "usd.physics.bodies",
         ),
-        ("usd/payloads/base.usda", 'upAxis = "Z"', 'upAxis = "Y"', "usd.layers"),
+        (BASE, 'upAxis = "Z"', 'upAxis = "Y"', "usd.layers"),
         (  # physics in the geometry-only variant
             USDA,
             '"none" {',
-            '"none" (\n            prepend payload = @./payloads/physics.usda@\n        ) {',
+            '"none" (\n            prepend payload = @./rosie_1000/payloads/physics.usda@\n'
+            "        ) {",
             "usd.none.geometry_only",
+        ),
+        (  # the MuJoCo variant's armature off the MJCF's
+            "usd/rosie_1000/payloads/mujoco.usda",
+            "uniform double mjc:armature = ",
+            "uniform double mjc:armature = 1",
+            "usd.mujoco.mjc.joints",
+        ),
+        (  # a servo's gain off the MJCF's
+            "usd/rosie_1000/payloads/mujoco.usda",
+            "uniform double[] mjc:gainPrm = [",
+            "uniform double[] mjc:gainPrm = [1",
+            "usd.mujoco.mjc.actuators",
+        ),
+        (  # the Isaac asset's interface layer no longer matches the entry point
+            "usd/rosie_1000/rosie_1000.usda",
+            'string Physics = "physx"',
+            'string Physics = "physics"',
+            "usd.asset",
         ),
     ],
 )
@@ -287,7 +314,9 @@ def test_passive_springs_are_drives(kit_factory, tmp_path):
     text = path.read_text(encoding="utf-8")
     old = "float drive:angular:physics:stiffness = 0.07853982\n"
     assert text.count(old) == 2
-    (copy / PHYSICS).write_text(text.replace(old, old.replace("0.0785", "0.0885")))
+    (copy / path.relative_to(kit.kit_dir)).write_text(
+        text.replace(old, "= 0.0885".join(old.split("= 0.0785")))
+    )
     assert "usd.drive.stiffness" in {f.check for f in check_usd(Kit.open(copy)) if not f.ok}
 
 
@@ -368,7 +397,7 @@ def drop_normals(path: Path, mesh: str) -> None:
 def test_a_mesh_without_normals_fails(rosie_1000, tmp_path):
     kit = tmp_path / "kit"
     shutil.copytree(rosie_1000.kit_dir, kit)
-    drop_normals(kit / "usd/payloads/geometries.usd", "/geometries/link_2/collision_00")
+    drop_normals(kit / "usd/rosie_1000/payloads/geometries.usd", "/geometries/link_2/collision_00")
     failed = [f for f in check_usd(Kit.open(kit)) if not f.ok]
     assert [f.check for f in failed] == ["usd.normals"]
     assert "/rosie_1000/link_2/collisions/collision_00" in failed[0].detail

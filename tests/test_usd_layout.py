@@ -33,10 +33,13 @@ def test_files_and_layers(tmp_path):
 
     robot = model_from_spec("ecn_2r")
     files = usd.emit(robot)
-    names = {f"usd/payloads/{n}" for n in (*PAYLOADS, "physics.usda", "physx.usda")}
+    layers = (*PAYLOADS, "physics.usda", "physx.usda", "mujoco.usda")
+    names = {f"usd/ecn_2r/payloads/{n}" for n in layers}
     assert set(files) == {
         "usd/ecn_2r.usda",
         "usd/.thumbs/256x256/ecn_2r.usda.png",
+        "usd/ecn_2r/ecn_2r.usda",  # the Isaac asset: its folder is named as the file (RC.003)
+        "usd/ecn_2r/.thumbs/256x256/ecn_2r.usda.png",
         *names,
     }
     for rel, data in files.items():
@@ -46,12 +49,19 @@ def test_files_and_layers(tmp_path):
             assert data.startswith(b"#usda 1.0"), rel  # text, so that reviews see changes
             layer = Sdf.Layer.FindOrOpen(str(tmp_path / rel))
             assert layer.defaultPrim, rel
-    stage = Usd.Stage.Open(str(tmp_path / "usd/ecn_2r.usda"))
-    top = stage.GetDefaultPrim()
-    spec = stage.GetRootLayer().GetPrimAtPath(top.GetPath())
-    assert [str(r.assetPath) for r in spec.referenceList.prependedItems] == ["./payloads/base.usda"]
+    for rel, base in (
+        ("usd/ecn_2r/ecn_2r.usda", "./payloads/base.usda"),
+        ("usd/ecn_2r.usda", "./ecn_2r/payloads/base.usda"),
+    ):  # two interface layers over one set of payloads
+        stage = Usd.Stage.Open(str(tmp_path / rel))
+        top = stage.GetDefaultPrim()
+        spec = stage.GetRootLayer().GetPrimAtPath(top.GetPath())
+        assert [str(r.assetPath) for r in spec.referenceList.prependedItems] == [base]
+    assert files["usd/ecn_2r.usda"] == files["usd/ecn_2r/ecn_2r.usda"].replace(
+        b"@./payloads/", b"@./ecn_2r/payloads/"
+    )
     variants = top.GetVariantSet("Physics")
-    assert variants.GetVariantNames() == ["none", "physics", "physx"]
+    assert variants.GetVariantNames() == ["mujoco", "none", "physics", "physx"]
     assert variants.GetVariantSelection() == "physx"
     assert UsdGeom.GetStageUpAxis(stage) == "Z" and Usd.ModelAPI(top).GetKind() == "component"
     meta = stage.GetRootLayer().customLayerData["SimReady_Metadata"]
@@ -62,6 +72,8 @@ def test_files_and_layers(tmp_path):
 def test_binary_format_writes_the_entry_and_the_geometry_as_crates():
     files = usd.emit_binary(model_from_spec("ecn_2r"))
     assert files["usd/ecn_2r.usdc"].startswith(b"PXR-USDC")
-    assert files["usd/payloads/geometries.usd"].startswith(b"PXR-USDC")
-    assert files["usd/payloads/physics.usda"].startswith(b"#usda 1.0")
+    assert files["usd/ecn_2r/ecn_2r.usdc"].startswith(b"PXR-USDC")
+    assert files["usd/ecn_2r/payloads/geometries.usd"].startswith(b"PXR-USDC")
+    assert files["usd/ecn_2r/payloads/physics.usda"].startswith(b"#usda 1.0")
     assert "usd/.thumbs/256x256/ecn_2r.usdc.png" in files
+    assert "usd/ecn_2r/.thumbs/256x256/ecn_2r.usdc.png" in files

@@ -28,12 +28,15 @@ from simkit.check.usd_collision import collision_findings
 from simkit.check.usd_fk import fk_findings
 from simkit.check.usd_layout import (
     VARIANT_SET,
+    asset_findings,
     geometry_only_findings,
     layer_findings,
     normals_findings,
     robot_schema_findings,
     thumbnail_findings,
 )
+from simkit.check.usd_mimic import follower_servo, followers
+from simkit.check.usd_mjc import MJC_VARIANT, mjc_findings
 from simkit.kitio import layout
 
 #: USD stores masses, inertia, joint frames and drive gains as 32-bit floats (about 7
@@ -162,6 +165,7 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
         for a in range(mj.nu)
         if mj.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
     }
+    follows = followers(mj)
     for doc in kit.joints:
         usd = by_name.get(prim_name(doc["name"]))
         if usd is None:
@@ -169,11 +173,15 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
         jid = mj.joint(doc["name"]).id
         axes_exp.append(np.concatenate([mj.jnt_axis[jid], mj.jnt_pos[jid]]))
         axes_act.append(np.concatenate([usd.pose1[:3, :3] @ usd.axis, usd.pose1[:3, 3]]))
-        act = actuated.get(jid)
+        act, aim, follower = actuated.get(jid), 0.0, follower_servo(mj, jid, follows, actuated)
+        if follower is not None:  # a slide follower: driven by its leader's servo
+            act, aim = follower
         dof, qadr = int(mj.jnt_dofadr[jid]), int(mj.jnt_qposadr[jid])
         # a joint without a servo but with MJCF stiffness or damping is a passive spring-damper:
-        # a force drive aimed at springref (qpos_spring) with no force limit
-        spring = act is None and bool(mj.jnt_stiffness[jid] or mj.dof_damping[dof])
+        # a force drive aimed at springref (qpos_spring) with no force limit; a mimic follower
+        # has none
+        spring = act is None and jid not in follows
+        spring = spring and bool(mj.jnt_stiffness[jid] or mj.dof_damping[dof])
         if (
             bool(mj.jnt_limited[jid]) != (usd.limit is not None)
             or (act is None and not spring) != (usd.drive is None)
@@ -189,7 +197,7 @@ def _joint_findings(mj, kit: Kit, joints: list[UsdJoint], names: dict[str, str])
             per = 180.0 / math.pi if usd.kind == "revolute" else 1.0  # USD: gains per degree
             if act is not None:
                 gains = [mj.actuator_gainprm[act, 0], -mj.actuator_biasprm[act, 2]]
-                max_force, target = mj.actuator_forcerange[act, 1], 0.0
+                max_force, target = mj.actuator_forcerange[act, 1], aim
             else:
                 gains = [mj.jnt_stiffness[jid], mj.dof_damping[dof]]
                 max_force, target = math.inf, mj.qpos_spring[qadr]  # no limit: not compared
@@ -300,6 +308,9 @@ def check_usd(kit: Kit) -> list[Finding]:
     if not top or not all(f.ok for f in findings if f.check == "usd.open"):
         return findings
     findings += layer_findings(stage) + normals_findings(stage) + thumbnail_findings(path)
+    if path.parent.name == "usd":  # the kit's entry point: the Isaac asset is beside it
+        asset = path.parent / path.stem / path.name
+        findings += asset_findings(path, asset)
     variants = top.GetVariantSet(VARIANT_SET)
     names = variants.GetVariantNames() if top.HasVariantSets() else []
     if not names:  # a one-layer stage (kits before the Isaac asset structure)
@@ -311,6 +322,8 @@ def check_usd(kit: Kit) -> list[Finding]:
             findings += geometry_only_findings(stage)
             continue
         found = _physics(kit, stage, top)
+        if name == MJC_VARIANT:
+            found += mjc_findings(stage, top, load_control_mjcf(kit))
         if name != default:
             found = [replace(f, check=f"usd.{name}.{f.check[4:]}") for f in found]
         findings += found

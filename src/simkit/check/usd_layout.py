@@ -83,8 +83,8 @@ def robot_schema_findings(stage, top, links: dict[str, str], joints: list[str]) 
     ]
 
 
-def thumbnail_findings(path: Path) -> list[Finding]:
-    """`.thumbs/256x256/<entry file>.png` beside the entry layer, 256 x 256 pixels."""
+def thumbnail_findings(path: Path, check: str = "usd.thumbnail") -> list[Finding]:
+    """`.thumbs/256x256/<layer file>.png` beside an interface layer, 256 x 256 pixels."""
     from PIL import Image
 
     thumb = path.parent / ".thumbs" / f"{THUMB_SIZE}x{THUMB_SIZE}" / f"{path.name}.png"
@@ -94,11 +94,44 @@ def thumbnail_findings(path: Path) -> list[Finding]:
             size = image.size
     return [
         require(
-            "usd.thumbnail",
+            check,
             size == (THUMB_SIZE, THUMB_SIZE),
             f"{thumb.relative_to(path.parent.parent).as_posix()}: a {THUMB_SIZE} x "
             f"{THUMB_SIZE} PNG (found {size})",
         )
+    ]
+
+
+def _resolved_text(path: Path) -> tuple[str, int] | None:
+    """(the layer's text with each asset path it authors made absolute, how many), or None
+    where the file does not open: two interface layers in different folders over the same
+    payload files then read the same."""
+    from pxr import Sdf
+
+    layer = Sdf.Layer.FindOrOpen(str(path)) if path.is_file() else None
+    if layer is None:
+        return None
+    text = layer.ExportToString()
+    assets = sorted(set(layer.GetCompositionAssetDependencies()), key=len, reverse=True)
+    for asset in assets:
+        text = text.replace(f"@{asset}@", f"@{Path(layer.ComputeAbsolutePath(asset)).resolve()}@")
+    return text, len(assets)
+
+
+def asset_findings(entry: Path, asset: Path) -> list[Finding]:
+    """The Isaac asset `usd/NAME/NAME.usda` (folder named as the file, SimReady RC.003) is the
+    entry layer's twin: the same text over the same payload files, and its own thumbnail."""
+    pair = _resolved_text(entry), _resolved_text(asset)
+    same = None not in pair and pair[0] == pair[1]
+    arcs = pair[1][1] if pair[1] else 0
+    return [
+        require(
+            "usd.asset",
+            same and asset.parent.name == asset.stem and arcs > 0,
+            f"{asset.parent.name}/{asset.name}: the entry layer's twin over the same "
+            f"{arcs} payload files, in a folder named as the file",
+        ),
+        *thumbnail_findings(asset, "usd.asset.thumbnail"),
     ]
 
 
@@ -109,8 +142,8 @@ def geometry_only_findings(stage) -> list[Finding]:
     physics, meshes = [], 0
     for prim in Usd.PrimRange(stage.GetPseudoRoot()):
         meshes += prim.IsA(UsdGeom.Mesh)
-        if str(prim.GetTypeName()).startswith("Physics") or any(
-            s.startswith(("Physics", "Physx", "Isaac")) for s in applied(prim)
+        if str(prim.GetTypeName()).startswith(("Physics", "Mjc")) or any(
+            s.startswith(("Physics", "Physx", "Isaac", "Mjc")) for s in applied(prim)
         ):
             physics.append(str(prim.GetPath()))
     return [

@@ -50,23 +50,27 @@ def glb(robot: str) -> str:
 
 
 def usd(robot: str, binary: bool = False) -> str:
-    """The USD entry point: the interface layer of Isaac Sim's robot asset structure."""
+    """The USD entry point users open: an interface layer over the Isaac asset's payloads."""
     return f"usd/{robot}.{'usdc' if binary else 'usda'}"
 
 
-#: the interface layer's payload layers, named as Isaac Sim's asset structure and the SimReady
-#: composition rule (ISA.001) name them, in their own folder beside it
-USD_PAYLOADS = "usd/payloads"
+def usd_asset(robot: str, binary: bool = False) -> str:
+    """The Isaac Sim robot asset's interface layer, `usd/NAME/NAME.usda`: the folder is named
+    as the file, as Isaac Sim's asset library and the SimReady naming rule (RC.003) ask."""
+    return f"usd/{robot}/{robot}.{'usdc' if binary else 'usda'}"
 
 
-def usd_payload(layer: str) -> str:
-    """`base.usda` -> `usd/payloads/base.usda`."""
-    return f"{USD_PAYLOADS}/{layer}"
+def usd_payload(robot: str, layer: str) -> str:
+    """`base.usda` -> `usd/NAME/payloads/base.usda`: named as Isaac Sim's asset structure and
+    the SimReady composition rule (ISA.001) name them, beside the asset's interface layer."""
+    return f"usd/{robot}/payloads/{layer}"
 
 
-def usd_thumbnail(robot: str, binary: bool = False) -> str:
-    """The entry layer's thumbnail where Omniverse and the SimReady rules look for it."""
-    return f"usd/.thumbs/256x256/{usd(robot, binary).rsplit('/', 1)[-1]}.png"
+def usd_thumbnail(usd_file: str) -> str:
+    """`usd/NAME.usda` -> `usd/.thumbs/256x256/NAME.usda.png`: the thumbnail of a USD layer,
+    where Omniverse and the SimReady rules look for it."""
+    folder, name = posixpath.split(usd_file)
+    return posixpath.join(folder, ".thumbs", "256x256", f"{name}.png")
 
 
 def visual_mesh(link: str) -> str:

@@ -3,13 +3,16 @@ Isaac robot schema) for Isaac Sim, Isaac Lab, Newton and other USD consumers.
 
 Files (Z up, metres, kilograms; each layer has a default prim; docs/usd.md):
 
-- `usd/NAME.usda`: the interface layer, the entry point (interface.py);
-- `usd/payloads/base.usda`: the hierarchy, `/NAME/LINK` Xforms at q = 0 (base.py);
-- `usd/payloads/geometries.usd`, `instances.usda`, `materials.usda`: meshes, the links'
+- `usd/NAME/NAME.usda`: the Isaac Sim robot asset's interface layer (interface.py), in a
+  folder named as the robot, as Isaac Sim's asset library lays robots out;
+- `usd/NAME.usda`: the entry point users open, the same interface layer over the same
+  payloads (only its payload paths differ), so kits before this layout open as they did;
+- `usd/NAME/payloads/base.usda`: the hierarchy, `/NAME/LINK` Xforms at q = 0 (base.py);
+- `usd/NAME/payloads/geometries.usd`, `instances.usda`, `materials.usda`: meshes, the links'
   visuals and colliders, the materials (geometry.py);
-- `usd/payloads/physics.usda`, `physx.usda`: UsdPhysics and the PhysX additions (physics.py,
-  physx.py, robot_schema.py);
-- `usd/.thumbs/256x256/NAME.usda.png`: the thumbnail (thumbnail.py).
+- `usd/NAME/payloads/physics.usda`, `physx.usda`, `mujoco.usda`: UsdPhysics, the PhysX and
+  the MuJoCo additions (physics.py, physx.py, mujoco.py, robot_schema.py);
+- `.thumbs/256x256/<layer>.png` beside both interface layers: the thumbnail (thumbnail.py).
 
 Layers are built in memory and serialised with `Sdf.Layer.ExportToString`, so the text holds no
 file names, timestamps or absolute paths; numbers are rounded as `fmt.num` prints them, so the
@@ -18,10 +21,13 @@ same model gives the same bytes.
 
 from __future__ import annotations
 
+import posixpath
+
 from simkit.emit.usd.base import base_text
 from simkit.emit.usd.common import axis_frame, place, prim_name
 from simkit.emit.usd.geometry import geometries_text, instances_text, materials_text
 from simkit.emit.usd.interface import DEFAULT_VARIANT, VARIANT_SET, VARIANTS, interface_text
+from simkit.emit.usd.mujoco import mujoco_text
 from simkit.emit.usd.physics import physics_text
 from simkit.emit.usd.physx import physx_text
 from simkit.emit.usd.thumbnail import thumbnail_png
@@ -60,6 +66,7 @@ def layers(robot: Robot) -> dict[str, str]:
         "materials.usda": materials_text(robot),
         "physics.usda": physics_text(robot),
         "physx.usda": physx_text(robot),
+        "mujoco.usda": mujoco_text(robot),
     }
 
 
@@ -80,14 +87,18 @@ def _usdc_bytes(text: str) -> bytes:
 
 
 def emit(robot: Robot, binary: bool = False) -> dict[str, bytes]:
-    """The entry layer `usd/NAME.usda` (or `.usdc` with `binary=True`), its payload layers
-    and its thumbnail."""
-    entry = interface_text(robot)
-    files = {layout.usd(robot.name, binary): _usdc_bytes(entry) if binary else entry.encode()}
+    """The entry layer `usd/NAME.usda` (or `.usdc` with `binary=True`), the Isaac asset's
+    interface layer `usd/NAME/NAME.usda`, their payload layers and thumbnails."""
+    files: dict[str, bytes] = {}
+    thumbnail = thumbnail_png(robot)
+    for path in (layout.usd(robot.name, binary), layout.usd_asset(robot.name, binary)):
+        folder = posixpath.relpath(layout.usd_payload(robot.name, ""), posixpath.dirname(path))
+        text = interface_text(robot, f"./{folder}")
+        files[path] = _usdc_bytes(text) if binary else text.encode()
+        files[layout.usd_thumbnail(path)] = thumbnail
     for name, text in layers(robot).items():
         crate = binary and name == GEOMETRIES
-        files[layout.usd_payload(name)] = _usdc_bytes(text) if crate else text.encode()
-    files[layout.usd_thumbnail(robot.name, binary)] = thumbnail_png(robot)
+        files[layout.usd_payload(robot.name, name)] = _usdc_bytes(text) if crate else text.encode()
     return dict(sorted(files.items()))
 
 

@@ -1,8 +1,10 @@
-"""`usd/NAME.usda`, the entry point: the interface layer of Isaac Sim's robot asset structure.
+"""The interface layer of Isaac Sim's robot asset structure, written twice over one set of
+payloads: `usd/NAME/NAME.usda` (the Isaac asset) and `usd/NAME.usda` (the kit's entry point).
 Its default prim `/NAME` (kind component) references `payloads/base.usda` and holds the variant
 set `Physics`: "none" (geometry only), "physics" (UsdPhysics: `physics.usda`, for any USD
-physics reader, Newton included) and "physx" (the default: `physics.usda` with `physx.usda` on
-top, for Isaac Sim). The root layer's customLayerData carries the SimReady provenance
+physics reader, Newton included), "physx" (the default: `physics.usda` with `physx.usda` on
+top, for Isaac Sim) and "mujoco" (`physics.usda` with `mujoco.usda`, MuJoCo's MjcPhysics
+schemas, on top). The root layer's customLayerData carries the SimReady provenance
 (`SimReady_Metadata`, rule SR.004) and simkit's own."""
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ VARIANTS = {
     "none": (),
     "physics": ("physics.usda",),
     "physx": ("physx.usda", "physics.usda"),
+    "mujoco": ("mujoco.usda", "physics.usda"),
 }
 DEFAULT_VARIANT = "physx"
 #: Wikidata's "robot" (Q11012): the SimReady category code of every kit
@@ -67,8 +70,8 @@ def metadata(robot: Robot) -> dict:
     }
 
 
-def interface_text(robot: Robot) -> str:
-    """The entry layer's text."""
+def interface_text(robot: Robot, payloads: str = "./payloads") -> str:
+    """An interface layer's text; `payloads` is the payload folder relative to the layer."""
     from pxr import Kind, Sdf, Usd
 
     name = prim_name(robot.name)
@@ -81,8 +84,8 @@ def interface_text(robot: Robot) -> str:
     variants.SetVariantSelection(DEFAULT_VARIANT)
     del stage
     spec = layer.GetPrimAtPath(f"/{name}")
-    spec.referenceList.Prepend(Sdf.Reference("./payloads/base.usda"))
+    spec.referenceList.Prepend(Sdf.Reference(f"{payloads}/base.usda"))
     for variant, files in VARIANTS.items():
-        payloads = spec.variantSets[VARIANT_SET].variants[variant].primSpec.payloadList
-        payloads.prependedItems = [Sdf.Payload(f"./payloads/{file}") for file in files]
+        arcs = spec.variantSets[VARIANT_SET].variants[variant].primSpec.payloadList
+        arcs.prependedItems = [Sdf.Payload(f"{payloads}/{file}") for file in files]
     return export(layer)

@@ -1,7 +1,15 @@
 """A mimic joint in `physics.usda`: PhysxMimicJointAPI, the coupling Isaac Sim reads and the
 SimReady rules DJ.004 and DJ.007 ask for on a follower without a drive. It sits in the physics
 layer, beside the joint state (also a PhysX schema), so both physics variants couple the
-follower as the MJCF's joint equality does."""
+follower as the MJCF's joint equality does.
+
+A prismatic follower is the exception: PhysX does not enforce a mimic on a linear DOF (the
+SimReady rules DJ.004 and DJ.006 say so, and want the follower's own drive with stiffness to
+hold it). Such a follower gets its leader's servo as its drive (physics.py) and no
+PhysxMimicJointAPI, as Isaac Sim's own parallel grippers drive both fingers: an authored
+coupling PhysX ignores would only mislead, and DJ.007's limit rule reads the gearing with the
+opposite sign to PhysX's (q + gearing q_leader + offset = 0), so a finger on 0..a that follows
+its leader with multiplier 1 could never pass it."""
 
 from __future__ import annotations
 
@@ -40,6 +48,14 @@ def apply_mimic(prim, robot: Robot, joint: Joint) -> None:
     for what, value in values.items():
         attr = prim.CreateAttribute(f"{base}:{what}", Sdf.ValueTypeNames.Float, False)
         attr.Set(rounded(value))
+
+
+def driven_follower(robot: Robot, joint: Joint) -> bool:
+    """A mimic follower that PhysX would not couple (a prismatic one) and whose leader has a
+    servo to lend it: driven instead."""
+    if joint.mimic is None or joint.type != "prismatic":
+        return False
+    return any(a.joint == joint.mimic[0] for a in robot.actuators)
 
 
 def _dof(joint: Joint) -> str:

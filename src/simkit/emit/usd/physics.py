@@ -29,7 +29,7 @@ from simkit.emit.usd.common import (
     quatf,
     r,
 )
-from simkit.emit.usd.mimic import apply_mimic
+from simkit.emit.usd.mimic import apply_mimic, driven_follower
 from simkit.emit.usd.robot_schema import apply_robot_schema
 from simkit.kitio.fmt import rounded
 from simkit.model.inertia import principal_axes
@@ -108,7 +108,7 @@ def _joint(stage, root: str, robot: Robot, joint: Joint, anchor: Joint | None) -
     if joint.movable:
         schema.CreateAxisAttr(token)
         _limits_and_drive(schema, robot, joint)
-    if joint.mimic is not None:
+    if joint.mimic is not None and not driven_follower(robot, joint):
         apply_mimic(schema.GetPrim(), robot, joint)
     return path
 
@@ -130,13 +130,20 @@ def _limits_and_drive(schema, robot: Robot, joint: Joint) -> None:
     for what in ("position", "velocity"):
         attr = prim.CreateAttribute(f"state:{kind}:physics:{what}", Sdf.ValueTypeNames.Float)
         attr.Set(0.0)
-    actuator = next((a for a in robot.actuators if a.joint == joint.name), None)
+    actuator, target = next((a for a in robot.actuators if a.joint == joint.name), None), 0.0
+    if actuator is None and joint.mimic is not None:
+        if not driven_follower(robot, joint):
+            return  # the mimic owns the DOF: no drive, not even a passive damper (DJ.004)
+        # PhysX does not enforce a linear mimic: the follower carries its leader's servo, aimed
+        # where the mimic puts it while the leader holds its target 0 (the offset, m)
+        actuator = next((a for a in robot.actuators if a.joint == joint.mimic[0]), None)
+        target = joint.mimic[2]
     # UsdPhysics DriveAPI angular gains are per degree (stiffness N m/deg, damping N m s/deg)
     # and its target position is in degrees.
     per = math.pi / 180.0 if angular else 1.0
     if actuator is not None:
         # MJCF position servo: tau = kp (q_ref - q) - kv qdot, |tau| <= forcerange.
-        gains, max_force, target = (actuator.kp, actuator.kv), actuator.forcerange, 0.0
+        gains, max_force = (actuator.kp, actuator.kv), actuator.forcerange
     elif joint.stiffness or joint.damping:
         # A passive spring-damper (MJCF joint stiffness, springref, damping; e.g. Asimov's toes,
         # 001_71a395c46b8a5939.txt "Toe Joints"): tau = -k (q - springref) - d qdot is a force

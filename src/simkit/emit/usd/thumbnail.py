@@ -1,10 +1,10 @@
-"""The USD thumbnail (`usd/.thumbs/256x256/NAME.usda.png`, where Omniverse and the SimReady
-rules RC.004 and SR.002 look): the robot's visual solids in the home pose, in the spec's
-colours, drawn by this module. A software render (a z-buffer over the solids' triangles,
-Lambert shading, drawn at twice the size and averaged down) and not MuJoCo's offscreen render:
-an emitter reads no OpenGL driver, so the same spec gives the same PNG bytes on every machine,
-a machine without EGL or OSMesa still builds the kit, and a solid cut into other triangles
-(round-off in a spec) draws the same pixels."""
+"""The USD thumbnail (`.thumbs/256x256/NAME.usda.png` beside each interface layer, where
+Omniverse and the SimReady rules RC.004 and SR.002 look): the robot's visual solids in the
+home pose, in the spec's colours, drawn by this module. A software render (a z-buffer over the
+solids' triangles, Lambert shading, drawn at twice the size and averaged down) and not MuJoCo's
+offscreen render: an emitter reads no OpenGL driver, so the same spec gives the same PNG bytes
+on every machine, a machine without EGL or OSMesa still builds the kit, and a solid cut into
+other triangles (round-off in a spec) draws the same pixels."""
 
 from __future__ import annotations
 
