@@ -48,8 +48,8 @@ def adjacent(robot) -> set[tuple[str, str]]:
 
 def model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=collision_shapes) -> str:
     """The search's collision-only MJCF (scratch.py): geoms from `shapes_of(link)` with half
-    the clearance as margin each, joined links and `also_excluded` pairs excluded, no
-    parent filter."""
+    the clearance as margin each, joined links, the pairs the source excludes
+    (`contact_excludes`) and `also_excluded` pairs excluded, no parent filter."""
     margin = text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
     scratch = Scratch(
         compiler={"angle": "radian"},
@@ -57,7 +57,7 @@ def model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=collis
         flags={"filterparent": "disable"},
     )
     scratch.tree(robot, base_dir, shapes_of)
-    scratch.exclude(sorted(adjacent(robot) | set(also_excluded)))
+    scratch.exclude(sorted(adjacent(robot) | set(also_excluded) | set(robot.contact_excludes)))
     return scratch.xml()
 
 

@@ -12,7 +12,6 @@ from pathlib import PurePosixPath
 
 from simkit.errors import SpecError
 from simkit.importer.fixups import collide, settle
-from simkit.importer.fixups.scratch import compiled
 from simkit.importer.read.mjcf import MjcfSource
 
 
@@ -43,42 +42,6 @@ def keep(draft, source: MjcfSource) -> dict:
 
 def _main_key(source: MjcfSource) -> str:
     return source.path.name
-
-
-def refuse_excluded_contact(draft, source: MjcfSource) -> None:
-    """One line when two bodies the MJCF excludes from contact (`<exclude>`) still touch at
-    the kit's home: a kit excludes only adjacent links (and pairs touching everywhere), so
-    its contact checks would fail on a pair the source lets overlap. Links collide as in
-    the import's home search (fixups/collide.py: collision hulls and the visual pieces they
-    are grown to cover)."""
-    model = source.model
-    if not model.nexclude:
-        return
-    robot = draft.robot()
-    start, follow = collide.posed(robot)
-    if start is None:
-        return
-    renamed = draft.renames.get("links", {})
-    excluded = set()
-    for e in range(model.nexclude):
-        sig = int(model.exclude_signature[e])
-        a, b = (model.body(i).name for i in (sig >> 16, sig & 0xFFFF))
-        a, b = renamed.get(a, a), renamed.get(b, b)
-        excluded.add((a, b) if a < b else (b, a))
-    xml = collide.model_xml(robot, draft.stage, shapes_of=collide.covered_shapes)
-    built, data, adr = compiled(xml, robot.movable_joints)
-    touching = collide.contacts(built, data, adr, start) & excluded
-    if touching:  # pairs touching almost everywhere: the kit excludes them too
-        shapes = collide.covered_shapes
-        touching -= set(collide.always_touching(robot, draft.stage, start, follow, shapes))
-    touching = sorted(touching)
-    if touching:
-        a, b = touching[0]
-        raise SpecError(
-            str(source.path), None, "contact.exclude",
-            f"bodies {a} and {b} touch at the kit's home: the MJCF excludes the pair from "
-            "contact, a kit cannot carry that (it excludes adjacent links only)",
-        )  # fmt: skip
 
 
 #: m the base may sink while the kit's servos hold home (check/legged.py's drift tolerance)
