@@ -64,6 +64,7 @@ FALLING = """<mujoco model="m">
 
 
 def test_a_floating_robot_that_cannot_stand_is_refused(tmp_path):
-    """A pole on a round end with an arm to one side falls over: a kit could not hold it."""
+    """A pole on a round end with an arm to one side falls over: a kit could not hold it.
+    The line names the construct, at the free joint's line."""
     line = _refused(write(tmp_path, FALLING), tmp_path / "out")
-    assert "does not stand" in line
+    assert "model.xml:3: freejoint: a free base that needs active balance" in line

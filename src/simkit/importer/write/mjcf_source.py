@@ -52,7 +52,9 @@ def refuse_falling(draft, source: MjcfSource) -> None:
     """One line when a floating MJCF robot does not stand on the kit's servos: its base,
     started on the floor at home, sinks more than `DRIFT` in the import's settle run
     (fixups/settle.py: its collision geometry, real masses, servos as the kit's). An RL
-    model made to fall (a humanoid on round feet) would fail the kit's standing check."""
+    model made to fall (a humanoid on round feet) would fail the kit's standing check. The
+    line names the construct: a free base that needs active balance (and, where the MJCF
+    drives its joints by torque `<motor>`s, says so), at the free joint's line."""
     if not draft.floating:
         return
     robot = draft.robot()
@@ -62,8 +64,16 @@ def refuse_falling(draft, source: MjcfSource) -> None:
     settler = settle.Settler(robot, draft.stage, start, follow)
     height, rest = settler.height(start), settler.run(start)
     if height - rest.xyz[2] > DRIFT:
+        model = source.model
+        free = [j for j in range(model.njnt) if model.jnt_type[j] == 0]
+        motors = any(
+            model.actuator_gaintype[a] == 0 and model.actuator_biastype[a] == 0
+            for a in range(model.nu)
+        )
+        why = "torque <motor>s drive its joints; " if motors else ""
         raise SpecError(
-            str(source.path), None, "freejoint",
-            f"the floating robot does not stand on a kit's servos at home: its base sinks "
-            f"{height - rest.xyz[2]:.2f} m in {settle.SECONDS:g} s (a kit must hold its pose)",
+            str(source.path), source.lines.get(("jnt", free[0])) if free else None, "freejoint",
+            f"a free base that needs active balance: on a kit's position servos at home it "
+            f"sinks {height - rest.xyz[2]:.2f} m in {settle.SECONDS:g} s ({why}a kit carries "
+            "no balance controller)",
         )  # fmt: skip
