@@ -12,6 +12,7 @@ derive/collision_pairs.py to share (docs/architecture.md).
 
 from __future__ import annotations
 
+import hashlib
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -28,6 +29,26 @@ KINDS = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}
 def text(values) -> str:
     """Numbers as MJCF text, full precision (repr)."""
     return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+#: a mesh's vertex text by (STL digest, scale): an import compiles a dozen scratch models of
+#: the same meshes, and reading, merging and printing a CAD mesh's vertices cost more than
+#: MuJoCo's compile of them; the bytes are the same either way
+_VERTEX_TEXT: dict[tuple[bytes, tuple[float, ...]], str] = {}
+_VERTEX_TEXT_MAX = 1024
+
+
+def mesh_text(path: Path, scale) -> str:
+    """The MJCF `vertex` text of the STL at `path` (merged vertices, scaled), computed once
+    per file content and scale."""
+    data = path.read_bytes()
+    key = (hashlib.sha256(data).digest(), tuple(float(v) for v in np.ravel(scale)))
+    found = _VERTEX_TEXT.get(key)
+    if found is None:
+        if len(_VERTEX_TEXT) >= _VERTEX_TEXT_MAX:
+            _VERTEX_TEXT.clear()
+        found = _VERTEX_TEXT[key] = text(from_stl(data).vertices * scale)
+    return found
 
 
 def principal(tensor) -> dict[str, str]:
@@ -104,8 +125,8 @@ class Scratch:
         """One geom of a spec shape in the link frame (a cone: its bounding cylinder)."""
         attrs = {"pos": text(shape.xyz), "quat": text(quat_wxyz(rpy_matrix(shape.rpy)))}
         if shape.kind == "mesh":
-            vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
-            ET.SubElement(self.asset, "mesh", name=name, vertex=text(vertices))
+            vertex = mesh_text(base_dir / shape.file, shape.scale)
+            ET.SubElement(self.asset, "mesh", name=name, vertex=vertex)
             attrs.update(type="mesh", mesh=name)
         elif shape.kind == "box":
             attrs.update(type="box", size=text(np.asarray(shape.size) / 2))
