@@ -166,14 +166,27 @@ class Scratch:
         return ET.tostring(self.root, encoding="unicode")
 
 
+#: compiled scratch models by their MJCF's digest: the searches of one import compile the
+#: same collision model several times (the home search, the always-touching pairs, the
+#: limits); no caller changes a model, each gets its own data
+_COMPILED: dict[bytes, object] = {}
+_COMPILED_MAX = 8
+
+
 def compiled(xml: str, joints) -> tuple:
-    """(model, data, qpos address of each of `joints`) of a scratch MJCF. MuJoCo is imported
-    in a held section (kitio/interrupt.py): a signal that arrives while its extension
-    initialises would break that import (an ImportError, not the clean interruption), so it
-    takes effect once the import is done."""
+    """(model, data, qpos address of each of `joints`) of a scratch MJCF, compiled once per
+    text (a fresh MjData each call). MuJoCo is imported in a held section
+    (kitio/interrupt.py): a signal that arrives while its extension initialises would break
+    that import (an ImportError, not the clean interruption), so it takes effect once the
+    import is done."""
     with interrupt.held():
         import mujoco
 
-    model = mujoco.MjModel.from_xml_string(xml)
+    key = hashlib.sha256(xml.encode()).digest()
+    model = _COMPILED.get(key)
+    if model is None:
+        if len(_COMPILED) >= _COMPILED_MAX:
+            _COMPILED.clear()
+        model = _COMPILED[key] = mujoco.MjModel.from_xml_string(xml)
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in joints], dtype=int)
     return model, mujoco.MjData(model), adr
