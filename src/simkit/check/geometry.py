@@ -18,6 +18,7 @@ from simkit.model.kinematics import axis_angle, quat_matrix, transform
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
 CONVEX_TOL = 1e-6  # m: float32 STL round-off on a face plane
 COVER_TOL = 1e-5  # m: a visual vertex may sit this far outside the pieces (float32 files)
+PLANE_BLOCK = 1 << 21  # matrix entries per block of `_plane_max` (16 MB of float64)
 GLB_FK_TOL = 1e-6  # m and rotation-matrix entries: 10 significant digits in the GLB JSON
 
 
@@ -34,11 +35,9 @@ def _outside(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.
 
 def _cover_gap(points: np.ndarray, pieces: list[np.ndarray]) -> float:
     """The largest distance (m) of a point outside every piece's convex hull; 0 when each
-    lies in one. Each point is measured against each piece's facet planes, those at its
-    nearest hull vertices first (model/hull.py `facet_depth`): exact wherever it is less than
-    `COVER_TOL` outside some piece, and a point at least that far outside every piece is
-    then measured against every plane. (qhull's tetrahedra held most points, but their walk
-    took seconds on a few hundred points outside a thin piece.)"""
+    lies in one: each point against every facet plane of each piece (qhull's), in blocks.
+    (qhull's tetrahedra held most points first, but their walk took up to 20 s on a few
+    hundred points just outside a thin piece; a visual mesh's vertices lie on its hull.)"""
     from scipy.spatial import QhullError
 
     points = np.asarray(points, dtype=float)
@@ -52,12 +51,20 @@ def _cover_gap(points: np.ndarray, pieces: list[np.ndarray]) -> float:
         return 0.0
     if not hulls:
         return float("inf")
-    depth = np.min([facet_depth(points, hull, COVER_TOL) for hull in hulls], axis=0)
-    far = np.flatnonzero(depth >= COVER_TOL)  # lower bounds: measured in full
-    if len(far):
-        planes = [hull.equations for hull in hulls]
-        depth[far] = np.min([(points[far] @ e[:, :3].T + e[:, 3]).max(axis=1) for e in planes], 0)
+    depth = np.min([_plane_max(points, hull.equations) for hull in hulls], axis=0)
     return max(0.0, float(depth.max()))
+
+
+def _plane_max(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
+    """Per point, the largest n . p + d over `planes` (unit normals, m), in blocks of at most
+    `PLANE_BLOCK` matrix entries."""
+    rows = max(1, PLANE_BLOCK // max(len(planes), 1))
+    return np.concatenate(
+        [
+            (points[i : i + rows] @ planes[:, :3].T + planes[:, 3]).max(axis=1)
+            for i in range(0, len(points), rows)
+        ]
+    )
 
 
 #: m: a dent shallower than this is measured no closer (model/hull.py `facet_depth`)
