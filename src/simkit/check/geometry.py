@@ -12,13 +12,12 @@ from simkit.check.mujoco import random_configs
 from simkit.check.readers.glb import read_glb
 from simkit.kitio.obj import read_mesh
 from simkit.kitio.stl import from_stl
-from simkit.model.hull import facet_depth, facet_planes
+from simkit.model.hull import facet_depth, facet_planes, plane_max
 from simkit.model.kinematics import axis_angle, quat_matrix, transform
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
 CONVEX_TOL = 1e-6  # m: float32 STL round-off on a face plane
 COVER_TOL = 1e-5  # m: a visual vertex may sit this far outside the pieces (float32 files)
-PLANE_BLOCK = 1 << 21  # matrix entries per block of `_plane_max` (16 MB of float64)
 GLB_FK_TOL = 1e-6  # m and rotation-matrix entries: 10 significant digits in the GLB JSON
 
 
@@ -35,7 +34,8 @@ def _outside(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.
 
 def _cover_gap(points: np.ndarray, pieces: list[np.ndarray]) -> float:
     """The largest distance (m) of a point outside every piece's convex hull; 0 when each
-    lies in one: each point against every facet plane of each piece (qhull's), in blocks.
+    lies in one: each point against the facet planes of each piece (qhull's) that can hold
+    its maximum (model/hull.py `plane_max`).
     (qhull's tetrahedra held most points first, but their walk took up to 20 s on a few
     hundred points just outside a thin piece; a visual mesh's vertices lie on its hull.)"""
     from scipy.spatial import QhullError
@@ -51,20 +51,8 @@ def _cover_gap(points: np.ndarray, pieces: list[np.ndarray]) -> float:
         return 0.0
     if not hulls:
         return float("inf")
-    depth = np.min([_plane_max(points, hull.equations) for hull in hulls], axis=0)
+    depth = np.min([plane_max(points, hull.equations) for hull in hulls], axis=0)
     return max(0.0, float(depth.max()))
-
-
-def _plane_max(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
-    """Per point, the largest n . p + d over `planes` (unit normals, m), in blocks of at most
-    `PLANE_BLOCK` matrix entries."""
-    rows = max(1, PLANE_BLOCK // max(len(planes), 1))
-    return np.concatenate(
-        [
-            (points[i : i + rows] @ planes[:, :3].T + planes[:, 3]).max(axis=1)
-            for i in range(0, len(points), rows)
-        ]
-    )
 
 
 #: m: a dent shallower than this is measured no closer (model/hull.py `facet_depth`)
