@@ -52,6 +52,8 @@ class MjcfSource(Source):
     #: (kind, compiled id) -> line in the model file of each body, geom, jnt and site
     #: (`lines`): the report's records name it
     lines: dict[tuple[str, int], int] = field(default_factory=dict)
+    #: the keys of `lines` that are an `<include>`'s line (shared by what it brings in)
+    included: set[tuple[str, int]] = field(default_factory=set)
 
 
 def _head(path: Path) -> bytes | None:
@@ -93,7 +95,7 @@ def read(shell: Source, options: ReadOptions) -> MjcfSource:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         source.spec, source.model = _compile(shell.path)
-    source.lines = lines(source.spec, source.model, included)
+    source.lines, source.included = lines(source.spec, source.model, included)
     for warning in caught:  # MuJoCo's own warnings (a deprecated attribute): one line each
         source.note(Position("mujoco", None), f"MuJoCo: {' '.join(str(warning.message).split())}")
     if source.model.nbody > MAX_BODIES:
@@ -127,18 +129,23 @@ KINDS = (("bodies", "body"), ("geoms", "geom"), ("joints", "jnt"), ("sites", "si
 BODY_OF = {"geom": "geom_bodyid", "jnt": "jnt_bodyid", "site": "site_bodyid"}
 
 
-def lines(spec, model, included: dict[tuple[str, str], int]) -> dict[tuple[str, int], int]:
-    """(kind, compiled id) -> line in the model file. MuJoCo's parser records each element's
-    line (`info`, "line N"), but 0 for one read from an `<include>`: that one gets the line of
-    the `<include>` in the model file that brought its name in (`included`, by tag and name),
-    else its body's line."""
+def lines(
+    spec, model, included: dict[tuple[str, str], int]
+) -> tuple[dict[tuple[str, int], int], set[tuple[str, int]]]:
+    """(kind, compiled id) -> line in the model file, and the keys whose line is an
+    `<include>`'s. MuJoCo's parser records each element's line (`info`, "line N"), but 0 for
+    one read from an `<include>`: that one gets the line of the `<include>` in the model file
+    that brought its name in (`included`, by tag and name), else its body's line."""
     tags = {"body": "body", "geom": "geom", "jnt": "joint", "site": "site"}
     out: dict[tuple[str, int], int] = {}
+    shared: set[tuple[str, int]] = set()
     for listed, kind in KINDS:
         for element in getattr(spec, listed):
             found = re.fullmatch(r"line (\d+)", element.info or "")
             line = int(found.group(1)) if found else 0
-            line = line or included.get((tags[kind], element.name), 0)
+            if not line and (tags[kind], element.name) in included:
+                line = included[(tags[kind], element.name)]
+                shared.add((kind, int(element.id)))
             if line and element.id >= 0:
                 out[(kind, int(element.id))] = line
     for kind, body_of in BODY_OF.items():
@@ -146,7 +153,9 @@ def lines(spec, model, included: dict[tuple[str, str], int]) -> dict[tuple[str, 
             body = ("body", int(getattr(model, body_of)[i]))
             if (kind, i) not in out and body in out:
                 out[(kind, i)] = out[body]
-    return out
+                if body in shared:
+                    shared.add((kind, i))
+    return out, shared
 
 
 def _confined(

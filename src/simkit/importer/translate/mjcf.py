@@ -123,21 +123,33 @@ def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple
         _sites(robot, model, body, names, off[body])
     why = "added: a link between two joints of one MJCF body"
     listed += [(f"links.{name}", why) for name in added]
-    _lines(robot, source.lines, root_body)
+    _lines(robot, source, root_body)
     return robot, bool(floating), listed
 
 
-def _lines(robot, lines: dict[tuple[str, int], int], root_body: int) -> None:
+def _lines(robot, source: MjcfSource, root_body: int) -> None:
     """Each element's `sourceline`: the MJCF line of the body, joint, geom or site it comes
     from (read/mjcf.py `lines`, recorded in the `mjcf` attribute as KIND:ID), else its
-    parent element's; the `<robot>` the root body's. The report's records name it."""
-    robot.sourceline = lines.get(("body", root_body))
+    parent element's; the `<robot>` the root body's. The report's records name it, and
+    provenance finds an element's records by line and element: so an element without a
+    name (a visual, a joint's limit) brought in by an `<include>`, whose line all it brings
+    in share, gets none."""
+    robot.sourceline = source.lines.get(("body", root_body)) or 0  # 0: none known
+    shared = set()
     for element in robot.iter():
         if element is robot:
             continue
         kind, _, index = (element.attrib.pop("mjcf", "") or ":").partition(":")
-        line = lines.get((kind, int(index))) if index else None
-        element.sourceline = line or element.getparent().sourceline
+        key = (kind, int(index)) if index else None
+        parent = element.getparent()
+        line = source.lines.get(key) if key else None
+        if key in source.included or (key is None and parent in shared):
+            shared.add(element)
+        if line is None and parent not in shared:
+            line = parent.sourceline
+        if element in shared and element.get("name") is None:
+            line = None
+        element.sourceline = line or 0
 
 
 class Names:
