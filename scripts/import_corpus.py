@@ -14,13 +14,17 @@ never a traceback; the re-import gives byte-identical files and no stale ones. T
 (one per `--title`, default the folder's name) goes into docs/import-corpus.md, replacing
 that corpus's earlier table, with the median import + cold build time. Runs one command at a
 time, or with `--ray` one Ray task per URDF ($RAY_ADDRESS, else a local Ray), rows in the
-same order: the same table. No robot is named here."""
+same order: the same table. Beside the wall seconds each row gives the CPU seconds of the
+import and the build (their processes and children: the figure other work on the machine
+does not inflate) and the load average when it started. No robot is named here."""
 
 from __future__ import annotations
 
 import argparse
 import fnmatch
+import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
@@ -90,6 +94,12 @@ def _name(rel: Path) -> str:
     return name
 
 
+def _cpu() -> float:
+    """CPU seconds (user + system) of this process's waited-for children so far."""
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
+
+
 def _run(args: list[str], timeout: float) -> tuple[int, str, str, float]:
     """Exit code, stdout, stderr and wall seconds of one simkit command."""
     start = time.perf_counter()
@@ -131,7 +141,8 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
     rel = urdf.relative_to(root)
     name = _name(rel)
     row = {"robot": rel.as_posix(), "import": "", "build": "", "reason": "", "invariant": "ok",
-           "seconds": None, "base": ""}  # fmt: skip
+           "seconds": None, "cpu": None, "base": "", "load": os.getloadavg()[0]}  # fmt: skip
+    cpu = _cpu()
     out = work / "specs" / name
     shutil.rmtree(out, ignore_errors=True)
     rc, stdout, stderr, import_s = _run(["import", str(urdf), "--name", name, "--out", str(out)],
@@ -151,6 +162,7 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
     build = ["build", str(out / f"{name}.yaml"), "--out", str(work / "kits"), "-q"]
     rc, _o, stderr, build_s = _run([*build, "--cache-dir", str(cache)], timeout)
     row["seconds"] = import_s + build_s
+    row["cpu"] = _cpu() - cpu  # the import's and the build's, with their child processes
     failed = re.search(r"FAIL ([\w.]+)", stderr)
     if rc == 0:
         row["build"] = "ok"
@@ -172,19 +184,26 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
 
 def table(rows: list[dict], total: int) -> str:
     kind = "MJCF" if rows and all(r["robot"].endswith(".xml") for r in rows) else "URDF"
-    head = f"| {kind} | base | import | build | invariant | import + cold build s | reason |"
-    lines = [head, "|---|---|---|---|---|---:|---|"]
+    head = (
+        f"| {kind} | base | import | build | invariant | import + cold build s | CPU s | load "
+        "| reason |"
+    )
+    lines = [head, "|---|---|---|---|---|---:|---:|---:|---|"]
     for r in rows:
         seconds = f"{r['seconds']:.1f}" if r["seconds"] is not None else ""
+        cpu = f"{r['cpu']:.1f}" if r.get("cpu") is not None else ""
         reason = r["reason"].replace("|", "\\|")
         lines.append(
             f"| {r['robot']} | {r['base']} | {r['import']} | {r['build']} | {r['invariant']} "
-            f"| {seconds} | {reason} |"
+            f"| {seconds} | {cpu} | {r.get('load', 0):.1f} | {reason} |"
         )
     passed = sum(r["build"] == "ok" for r in rows)
     kept = sum(r["invariant"] == "ok" for r in rows)
     times = [r["seconds"] for r in rows if r["seconds"] is not None]
     median = f"{statistics.median(times):.1f} s" if times else "n/a"
+    cpus = [r["cpu"] for r in rows if r.get("cpu") is not None]
+    if cpus:
+        median += f" wall, {statistics.median(cpus):.1f} s CPU"
     partial = "" if len(rows) == total else f" (partial: {len(rows)} of {total} run)"
     lines += [
         "",
@@ -202,7 +221,9 @@ def save(md: Path, title: str, command: str, body: str) -> None:
         text = (
             "# Import corpora\n\nMade by `scripts/import_corpus.py`: every URDF imported "
             "with `simkit import`'s default flags, built with an empty cache (wall seconds "
-            "on 2 shared cores), then imported again into the same folder.\n"
+            "on 2 shared cores; CPU seconds of the import and build processes, which the "
+            "other work on the machine does not inflate; the 1-minute load average when the "
+            "row started), then imported again into the same folder.\n"
         )
     section = f"## {title}\n\n`{command}`\n\n{body}"
     pattern = re.compile(rf"^## {re.escape(title)}\n.*?(?=^## |\Z)", re.S | re.M)

@@ -51,32 +51,6 @@ def test_malformed_xml_and_an_uncompilable_model_are_one_line(tmp_path):
     assert "MuJoCo cannot compile" in _refused(write(tmp_path, bad), tmp_path / "o")
 
 
-EXCLUDED = """<mujoco model="m">
-  <worldbody>
-    <body name="base"><geom type="box" size="0.4 0.4 0.1"/>
-      <body name="link1" pos="0 0 0.3"><joint name="j1" type="slide" axis="1 0 0" range="-2 2"/>
-        <geom type="capsule" fromto="0 0 0 0 0 0.1" size="0.02"/>
-        <body name="link2" pos="0 0 -0.3"><joint name="j2" axis="0 1 0" range="-3 3"/>
-          <geom type="sphere" size="0.05"/></body>
-      </body>
-    </body>
-  </worldbody>
-  <contact><exclude body1="base" body2="link2"/></contact>
-</mujoco>
-"""
-
-
-def test_an_excluded_pair_touching_at_home_is_refused(tmp_path, monkeypatch):
-    """The pair overlaps at the first guess; without the home search (left out here) it
-    stays so, and a kit, which cannot carry the `<exclude>`, would fail its contact checks."""
-    import simkit.importer as importer
-    from simkit.importer import translate
-
-    monkeypatch.setattr(importer, "STEPS", (translate.to_spec,))
-    line = _refused(write(tmp_path, EXCLUDED), tmp_path / "out")
-    assert "contact.exclude" in line and "base and link2" in line
-
-
 FALLING = """<mujoco model="m">
   <worldbody>
     <body name="pole" pos="0 0 1"><freejoint/>
@@ -90,6 +64,7 @@ FALLING = """<mujoco model="m">
 
 
 def test_a_floating_robot_that_cannot_stand_is_refused(tmp_path):
-    """A pole on a round end with an arm to one side falls over: a kit could not hold it."""
+    """A pole on a round end with an arm to one side falls over: a kit could not hold it.
+    The line names the construct, at the free joint's line."""
     line = _refused(write(tmp_path, FALLING), tmp_path / "out")
-    assert "does not stand" in line
+    assert "model.xml:3: freejoint: a free base that needs active balance" in line

@@ -12,7 +12,7 @@ from simkit.check.mujoco import random_configs
 from simkit.check.readers.glb import read_glb
 from simkit.kitio.obj import read_mesh
 from simkit.kitio.stl import from_stl
-from simkit.model.hull import facet_depth, facet_planes
+from simkit.model.hull import facet_depth, facet_planes, plane_max
 from simkit.model.kinematics import axis_angle, quat_matrix, transform
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
@@ -32,40 +32,26 @@ def _outside(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray) -> np.
     return (points @ n.T - d).max(axis=1)
 
 
-def _hull_outside(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
-    """How far each point lies outside the convex hull of `vertices` (<= 0: inside, m).
-
-    The planes are qhull's facet hyperplanes, not each triangle's own: a convex piece grown
-    to cover a visual mesh has sliver faces (area ~1e-9 m^2) between near-coplanar vertices,
-    whose cross-product normal can tilt by tens of degrees, so a plane through one of them
-    cuts the piece and reports a true convex piece as 0.1 m off (a 7-dof arm's upper link in
-    the corpus)."""
-    from scipy.spatial import QhullError
-
-    try:
-        planes = facet_planes(vertices).equations
-    except (QhullError, ValueError):  # flat or too few points: no solid, nothing inside it
-        return np.full(len(points), np.inf)
-    return (points @ planes[:, :3].T + planes[:, 3]).max(axis=1)
-
-
 def _cover_gap(points: np.ndarray, pieces: list[np.ndarray]) -> float:
     """The largest distance (m) of a point outside every piece's convex hull; 0 when each
-    lies in one. A point that qhull's tetrahedra of some piece hold is inside it; only the
-    others are measured against every facet plane of every piece (a 13,000-facet given hull
-    against its 6,500 visual vertices took 3 s measured in full)."""
-    from scipy.spatial import Delaunay, QhullError
+    lies in one: each point against the facet planes of each piece (qhull's) that can hold
+    its maximum (model/hull.py `plane_max`).
+    (qhull's tetrahedra held most points first, but their walk took up to 20 s on a few
+    hundred points just outside a thin piece; a visual mesh's vertices lie on its hull.)"""
+    from scipy.spatial import QhullError
 
-    left = np.asarray(points, dtype=float)
+    points = np.asarray(points, dtype=float)
+    hulls = []
     for vertices in pieces:
         try:
-            held = Delaunay(np.asarray(vertices, dtype=float)).find_simplex(left) >= 0
+            hulls.append(facet_planes(vertices))
         except (QhullError, ValueError):  # flat or too few points: holds nothing
             continue
-        left = left[~held]
-        if not len(left):
-            return 0.0
-    depth = np.min([_hull_outside(left, vertices) for vertices in pieces], axis=0)
+    if not len(points):
+        return 0.0
+    if not hulls:
+        return float("inf")
+    depth = np.min([plane_max(points, hull.equations) for hull in hulls], axis=0)
     return max(0.0, float(depth.max()))
 
 

@@ -383,7 +383,8 @@ def _servos(kit: Kit, mj: mujoco.MjModel, servos: list[dict]) -> list[Finding]:
 def _excludes(kit: Kit, mj: mujoco.MjModel) -> Finding:
     """MJCF <exclude> pairs are exactly the links joined by a joint, plus the pairs robot.json
     lists as in contact in every configuration (`collision_pairs.always`), each of which
-    must really touch (check/always.py)."""
+    must really touch (check/always.py), plus those the spec declares (`declared`: the
+    source excludes them; the MJCF source check compares them with the source's)."""
     from simkit.check.always import not_touching
 
     links = {link["name"] for link in kit.doc["links"]}
@@ -392,8 +393,8 @@ def _excludes(kit: Kit, mj: mujoco.MjModel) -> Finding:
         for j in kit.joints + kit.doc.get("fixed_joints", [])
         if j["parent"] in links and j["child"] in links
     }
-    always = [tuple(sorted(p)) for p in (kit.doc.get("collision_pairs") or {}).get("always", [])]
-    adjacent |= set(always)
+    block = kit.doc.get("collision_pairs") or {}
+    adjacent |= {tuple(sorted(p)) for key in ("always", "declared") for p in block.get(key, [])}
     apart = not_touching(kit, mj)
     if apart:
         return require("mjcf.excludes", False, f"excluded as always touching but apart: {apart}")

@@ -5,7 +5,9 @@ the kit's MJCF, and this compares, under the source's names (robot.json renames 
 - every body's mass, CoM and inertia (<= 1e-6 relative);
 - the pose of every body at 100 seeded configurations (<= 1e-6 m, 1e-6 in rotation),
   relative to the robot's root;
-- each joint's actuator force bound (|gear| x force range, else control range x gain).
+- each joint's actuator force bound (|gear| x force range, else control range x gain);
+- contact excludes: each source `<exclude>` between two kit bodies is one in the kit's MJCF,
+  and each pair robot.json declares (`collision_pairs.declared`) is one in the source.
 
 A difference passes only when robot.json's `source_differences` lists it (key as for a URDF:
 `joints.J.axis`, `links.B.mass`, ...). The source's other files (includes, meshes) are read
@@ -78,6 +80,9 @@ def compare(kit: Kit, allowed) -> list[Finding]:
         "source.fk", _fk(pairs), f"every body's pose agrees at {SEEDS} seeded configurations"
     )
     out += _findings("source.actuators", _actuators(pairs), "joint actuators' force bounds agree")
+    declared = (kit.doc.get("collision_pairs") or {}).get("declared", [])
+    excludes = _excludes(pairs, declared)
+    out += _findings("source.excludes", excludes, f"{source.nexclude} contact excludes agree")
     return out
 
 
@@ -356,6 +361,33 @@ def _actuators(p: Pairs) -> list[str]:
             out.append(
                 f"joint '{name}': actuator force bound {want:.9g} in the source, {got} in the kit"
             )
+    return out
+
+
+def _excluded(model, sig: int) -> frozenset:
+    """The two body names of a compiled `<exclude>` (its signature: body ids, 16 bits each)."""
+    return frozenset(_name(model, "body", i) for i in (sig >> 16, sig & 0xFFFF))
+
+
+def _excludes(p: Pairs, declared: list) -> list[str]:
+    """Each source `<exclude>` whose two bodies the kit has is excluded in the kit's MJCF too
+    (unless listed: `contact_excludes.NAME`), and each pair robot.json declares excluded is
+    one the source excludes: the kit may filter no contact the source keeps."""
+    s, k = p.source, p.kit
+    kit_pairs = {_excluded(k, int(sig)) for sig in k.exclude_signature}
+    source_pairs, out = set(), []
+    for e in range(s.nexclude):
+        a, b = sorted(_excluded(s, int(s.exclude_signature[e])))
+        ids = (p.kit_id("body", a), p.kit_id("body", b))
+        if min(ids) < 0:
+            continue  # no kit body (a body outside the robot's tree: listed)
+        pair = frozenset(_name(k, "body", i) for i in ids)
+        source_pairs.add(pair)
+        if pair not in kit_pairs and not p.listed(f"contact_excludes.{_name(s, 'exclude', e)}"):
+            out.append(f"bodies '{a}' and '{b}': excluded from contact in the source, not the kit")
+    for a, b in declared:
+        if frozenset((a, b)) not in source_pairs:
+            out.append(f"links '{a}' and '{b}': declared excluded, not excluded in the source")
     return out
 
 

@@ -362,18 +362,25 @@ def max_distance_to_surface(points: np.ndarray, surface: Mesh, nearest: int = 4)
     rows = np.repeat(np.arange(len(points)), k)
     upper = _point_triangle_distance(points[rows], tri[first.ravel()]).reshape(-1, k).min(axis=1)
     worst, slack, reach = 0.0, 1e-9, float(radius.max())
-    for i in np.argsort(-upper, kind="stable"):
-        if upper[i] <= worst:
-            break  # every point left has a smaller upper bound
-        near = np.asarray(tree.query_ball_point(points[i], upper[i] + reach + slack), dtype=int)
-        near = near[
-            np.linalg.norm(centre[near] - points[i], axis=1) - radius[near] <= upper[i] + slack
-        ]
-        best = upper[i]
+    order = np.argsort(-upper, kind="stable")
+    start, batch = 0, 16
+    while start < len(order) and upper[order[start]] > worst:
+        # a batch of points, largest upper bound first: a point whose bound cannot beat the
+        # maximum cannot raise it, so measuring a few past the stop changes nothing
+        ids = order[start : start + batch]
+        ids = ids[upper[ids] > worst]
+        start, batch = start + batch, min(batch * 2, 1024)
+        found = tree.query_ball_point(points[ids], upper[ids] + reach + slack)
+        rows = np.repeat(np.arange(len(ids)), [len(f) for f in found])
+        near = np.concatenate([np.asarray(f, dtype=int) for f in found] + [np.zeros(0, int)])
+        bound = upper[ids][rows] + slack
+        keep = np.linalg.norm(centre[near] - points[ids][rows], axis=1) - radius[near] <= bound
+        rows, near = rows[keep], near[keep]
+        best = upper[ids].copy()
         if len(near):
-            exact = _point_triangle_distance(np.repeat(points[i : i + 1], len(near), 0), tri[near])
-            best = min(best, float(exact.min()))
-        worst = max(worst, float(best))
+            exact = _point_triangle_distance(points[ids][rows], tri[near])
+            np.minimum.at(best, rows, exact)
+        worst = max(worst, float(best.max()))
     return worst
 
 

@@ -224,14 +224,17 @@ def _kit_collides(link: Link) -> bool:
     return link.collision_method != "primitives" and has_mesh
 
 
-def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
+def always_pairs(
+    robot: Robot, q: np.ndarray, declared: list[tuple[str, str]] = ()
+) -> list[tuple[str, str]]:
     """Link pairs the kit's MJCF would let collide whose collision geometry is in contact (or
     within `TOUCH`, numerically touching) in at least `ALWAYS_FRACTION` of the configurations
     of `q` (MoveIt Setup Assistant's "Always", its min_collision_fraction): a URDF's
     collision shapes that overlap wherever the joints are (a humanoid's hip-yaw and thigh
     hulls, a fingertip inside the hand's safety box but in one pose of a thousand, finger
     blocks sliding face on face) can never, or almost never, be separated, so their
-    contact is an artefact of the geometry, and the kit excludes it."""
+    contact is an artefact of the geometry, and the kit excludes it. `declared` pairs are
+    excluded already (the spec's `contact_excludes`) and never tested."""
     import mujoco
 
     if not len(q):
@@ -239,6 +242,7 @@ def always_pairs(robot: Robot, q: np.ndarray) -> list[tuple[str, str]]:
     q = follow_mimics(robot, q)
     need = math.ceil(ALWAYS_FRACTION * len(q) - 1e-9)
     skip = welded_pairs(robot) | {tuple(sorted(p)) for p in jointed_pairs(robot)}
+    skip |= {tuple(sorted(p)) for p in declared}
     kit = {link.name for link in robot.links if _kit_collides(link)}
     solid = sorted(link.name for link in robot.links if has_geometry(link))
     names = [j for j, _, _ in sampled_joints(robot)]
@@ -285,12 +289,15 @@ def follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
 def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
     """Adjacent, always-in-contact and never-in-contact link pairs
     (`products.collision_pairs`: the SRDF, the MJCF and USD excludes and robot.json
-    `collision_pairs`); the seed is the spec's. `always` is written only when not empty."""
+    `collision_pairs`); the seed is the spec's. `always` is written only when not empty,
+    and so is `declared`, the pairs the spec's `contact_excludes` declares (never sampled:
+    the source lets them overlap)."""
     seed = robot.seed
     adjacent = adjacent_pairs(robot)
+    declared = list(robot.contact_excludes)
     q = configurations(robot, seed, samples)
-    first = first_contacts(robot, q, adjacent)
-    always = always_pairs(robot, q[:ALWAYS_SAMPLES])
+    first = first_contacts(robot, q, [*adjacent, *declared])
+    always = always_pairs(robot, q[:ALWAYS_SAMPLES], declared)
     block = {
         "method": METHOD,
         "seed": seed,
@@ -307,5 +314,7 @@ def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
             "fraction": ALWAYS_FRACTION,
             "touch": TOUCH,
         }
+    if declared:
+        block["declared"] = [list(p) for p in declared]
     seeds = {**robot.products.seeds, "collision_pairs": seed}
     return replace(robot, products=replace(robot.products, collision_pairs=block, seeds=seeds))

@@ -17,7 +17,7 @@ from simkit.derive.collision_pairs import (
     welded_pairs,
 )
 from simkit.derive.solids import is_convex_union
-from simkit.model.kinematics import jointed_pairs, quat_wxyz, rpy_matrix
+from simkit.model.kinematics import excluded_pairs, jointed_pairs, quat_wxyz, rpy_matrix
 from simkit.model.robot import Link, Robot, Shape
 
 #: MJX's guidance: fewer than 32 vertices for convex-convex collisions
@@ -135,10 +135,9 @@ def scratch_xml(
 
 def never_collided(robot: Robot) -> set[tuple[str, str]]:
     """Link pairs the main MJCF never collides: joined by a joint, welded (MuJoCo's own
-    filters) and the `always` pairs it excludes; sorted name pairs."""
+    filters) and the `always` and declared pairs it excludes; sorted name pairs."""
     pairs = {tuple(sorted(p)) for p in jointed_pairs(robot)} | welded_pairs(robot)
-    always = (robot.products.collision_pairs or {}).get("always", [])
-    return pairs | {tuple(sorted(p)) for p in always}
+    return pairs | {tuple(sorted(p)) for p in excluded_pairs(robot)}
 
 
 def sampled_contacts(robot: Robot, geoms: list[dict], q: np.ndarray) -> list[tuple[float, set]]:

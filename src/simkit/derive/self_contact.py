@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from simkit.derive.collision_pairs import adjacent_pairs, collision_model_xml
+from simkit.model.kinematics import excluded_pairs
 from simkit.model.robot import Robot
 
 
@@ -20,8 +21,8 @@ def depth_function(robot: Robot, joints: Sequence[str]) -> Callable[[Sequence[fl
     of `joints` (rad or m), every other joint at 0."""
     import mujoco
 
-    always = [tuple(p) for p in (robot.products.collision_pairs or {}).get("always", [])]
-    skip = sorted(set(adjacent_pairs(robot)) | set(always))  # as the kit's MJCF excludes them
+    # as the kit's MJCF excludes them
+    skip = sorted(set(adjacent_pairs(robot)) | set(excluded_pairs(robot)))
     model = mujoco.MjModel.from_xml_string(collision_model_xml(robot, skip))
     data = mujoco.MjData(model)
     adr = [int(model.jnt_qposadr[model.joint(name).id]) for name in joints]

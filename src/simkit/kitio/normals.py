@@ -14,6 +14,7 @@ to 7 decimals (shading needs no more) so the files they go into are stable.
 
 from __future__ import annotations
 
+import hashlib
 import math
 
 import numpy as np
@@ -84,10 +85,31 @@ def _group_pairs(order: np.ndarray, starts: np.ndarray, sizes: np.ndarray):
     return order[a], order[b]
 
 
+#: corner normals by the digest of their mesh and crease angle: the GLB and the USD emitters
+#: shade the same link solids (a CAD mesh's normals take a second)
+_DONE: dict[bytes, np.ndarray] = {}
+_DONE_MAX = 256
+
+
 def corner_normals(
     vertices: np.ndarray, faces: np.ndarray, crease_deg: float = CREASE_DEG
 ) -> np.ndarray:
-    """(F, 3, 3) unit shading normal at each corner of each face (mesh frame)."""
+    """(F, 3, 3) unit shading normal at each corner of each face (mesh frame); computed once
+    per mesh content (a fresh copy each call)."""
+    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    digest = hashlib.sha256(vertices.tobytes())
+    digest.update(faces.tobytes())
+    digest.update(f"{vertices.shape} {faces.shape} {crease_deg!r}".encode())
+    key = digest.digest()
+    if key not in _DONE:
+        if len(_DONE) >= _DONE_MAX:
+            _DONE.clear()
+        _DONE[key] = _corner_normals(vertices, faces, crease_deg)
+    return _DONE[key].copy()
+
+
+def _corner_normals(vertices: np.ndarray, faces: np.ndarray, crease_deg: float) -> np.ndarray:
     faces = np.asarray(faces, dtype=np.int64)
     _unique, welded = np.unique(np.asarray(vertices), axis=0, return_inverse=True)
     vertex = welded.reshape(-1)[faces].reshape(-1)  # welded vertex of each corner

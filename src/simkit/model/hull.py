@@ -64,3 +64,39 @@ def _nearby_planes(points: np.ndarray, hull) -> np.ndarray:
     offsets = np.minimum(np.arange(width)[None, :], count[nearest].reshape(-1, 1) - 1)
     picked = facets[start[nearest].reshape(-1, 1) + offsets]
     return picked.reshape(len(points), k * width)
+
+
+#: grid cells per side for `plane_max`'s plane culling
+CELLS = 16
+
+
+def plane_max(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
+    """Per point, the largest n . p + d over `planes` (rows n_x, n_y, n_z, d; unit normals,
+    m): exact, cell by cell. The points are binned in a grid of `CELLS` per side; for a cell
+    of radius r about c, a plane can give a point its maximum only if its value at c plus r
+    reaches the largest value at c minus r, so each cell is measured against those planes
+    only (a 13,000-facet hull against 20,000 visual vertices: a few hundred planes a cell,
+    not all of them)."""
+    points = np.asarray(points, dtype=float)
+    if not len(points):
+        return np.zeros(0)
+    normals, offsets = planes[:, :3], planes[:, 3]
+    if len(points) * len(planes) <= CHUNK:
+        return (points @ normals.T + offsets).max(axis=1)
+    low = points.min(axis=0)
+    size = max(float((points.max(axis=0) - low).max()) / CELLS, 1e-9)
+    keys = np.floor((points - low) / size).astype(np.int64)
+    cells, owner = np.unique(keys, axis=0, return_inverse=True)
+    order = np.argsort(owner.ravel(), kind="stable")
+    bounds = np.searchsorted(owner.ravel()[order], np.arange(len(cells) + 1))
+    out = np.empty(len(points))
+    radius = size * np.sqrt(3.0) / 2.0
+    for k, key in enumerate(cells):
+        members = order[bounds[k] : bounds[k + 1]]
+        at_centre = normals @ (low + (key + 0.5) * size) + offsets
+        keep = at_centre + radius >= at_centre.max() - radius - 1e-12
+        rows = max(1, CHUNK // int(keep.sum()))
+        for i in range(0, len(members), rows):
+            block = members[i : i + rows]
+            out[block] = (points[block] @ normals[keep].T + offsets[keep]).max(axis=1)
+    return out

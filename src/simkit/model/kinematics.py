@@ -189,3 +189,12 @@ def jointed_pairs(robot: Robot) -> list[tuple[str, str]]:
     contacts the MJCF and USD exclude (MoveIt's wider `adjacent_pairs` is a derive step)."""
     links = {link.name for link in robot.links}
     return [(j.parent, j.child) for j in robot.joints if j.parent in links]
+
+
+def excluded_pairs(robot: Robot) -> list[tuple[str, str]]:
+    """The link pairs the kit excludes from contact besides `jointed_pairs`: the derived
+    `collision_pairs.always` pairs (in contact in every configuration), then `declared`
+    ones (the spec's `contact_excludes`, which the source excludes); each sorted. The MJCF
+    `<exclude>`s, the USD filtered pairs and the GPU scene take them."""
+    block = robot.products.collision_pairs or {}
+    return [(a, b) for key in ("always", "declared") for a, b in block.get(key, [])]

@@ -225,4 +225,5 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         source=None if spec.source is None else (spec.source.file, spec.source.sha256),
         source_assets=() if spec.source is None else tuple(sorted(spec.source.assets.items())),
         source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
+        contact_excludes=tuple(sorted(tuple(sorted(p)) for p in spec.contact_excludes)),
     )

@@ -315,6 +315,9 @@ class Robot:
     source_assets: tuple[tuple[str, str], ...] = ()
     #: the kit's intended differences from that source: (what, reason, kit name or None)
     source_differences: tuple[tuple[str, str, str | None], ...] = ()
+    #: link pairs the source excludes from contact (spec `contact_excludes`), names sorted
+    #: within each pair and the pairs sorted
+    contact_excludes: tuple[tuple[str, str], ...] = ()
 
     @cached_property
     def by_name(self) -> tuple[dict[str, Link], dict[str, Joint]]:

@@ -402,3 +402,6 @@ class RobotSpec(Strict):
     #: the imported source file and its digest, and the kit's intended differences from it
     source: SourceSpec | None = None
     source_differences: tuple[SourceDifference, ...] = ()
+    #: link pairs the source excludes from contact (an MJCF `<contact><exclude>`), each
+    #: `[LINK, LINK]`: every format that can filter a pair gets them (MJCF, USD, SRDF)
+    contact_excludes: tuple[tuple[str, str], ...] = ()

@@ -201,6 +201,7 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
         if value is not None and value not in names_seen:
             yield (key,), f"unknown link or frame '{value}'"
     yield from _planning_groups(spec)
+    yield from _contact_excludes(spec)
     for k, field in enumerate(spec.published.estimated):
         if field not in ESTIMABLE_ROBOT:
             yield ("published", "estimated", k), f"'{field}' is not a published figure"
@@ -225,6 +226,27 @@ def _planning_groups(spec: RobotSpec) -> Iterator[Problem]:
         if node != group.base:
             why = f"'{group.tip}' is not a link or frame below '{group.base}'"
             yield ("planning_groups", i, "tip"), why
+
+
+def _contact_excludes(spec: RobotSpec) -> Iterator[Problem]:
+    """Each excluded pair names two different links, not joined by a joint (a kit excludes
+    those already), and only once."""
+    links = {link.name for link in spec.links}
+    jointed = {frozenset((j.parent, j.child)) for j in spec.joints}
+    seen: set[frozenset] = set()
+    for i, (a, b) in enumerate(spec.contact_excludes):
+        pair = frozenset((a, b))
+        unknown = [n for n in (a, b) if n not in links]
+        if unknown:
+            yield ("contact_excludes", i), f"unknown link '{unknown[0]}'"
+        elif a == b:
+            yield ("contact_excludes", i), f"a link cannot be excluded from itself ('{a}')"
+        elif pair in jointed:
+            why = f"'{a}' and '{b}' are joined by a joint: excluded already"
+            yield ("contact_excludes", i), why
+        elif pair in seen:
+            yield ("contact_excludes", i), f"the pair '{a}', '{b}' is listed twice"
+        seen.add(pair)
 
 
 def _floating(spec: RobotSpec) -> Iterator[Problem]:

@@ -33,7 +33,7 @@ from simkit.emit.usd.mimic import apply_mimic, driven_follower
 from simkit.emit.usd.robot_schema import apply_robot_schema
 from simkit.kitio.fmt import rounded
 from simkit.model.inertia import principal_axes
-from simkit.model.kinematics import jointed_pairs, rpy_matrix
+from simkit.model.kinematics import excluded_pairs, jointed_pairs, rpy_matrix
 from simkit.model.robot import Joint, Link, Robot
 
 
@@ -164,12 +164,12 @@ def _limits_and_drive(schema, robot: Robot, joint: Joint) -> None:
 def _filtered_pairs(stage, root: str, robot: Robot) -> None:
     """Joints already ignore contacts between the two bodies they join; the explicit pair
     matches the MJCF <exclude> for readers that merge or drop fixed joints (and the pairs in
-    contact in every configuration, collision_pairs.always_pairs)."""
+    contact in every configuration, collision_pairs.always_pairs, and the spec's declared
+    `contact_excludes`)."""
     from pxr import UsdPhysics
 
-    always = [tuple(p) for p in (robot.products.collision_pairs or {}).get("always", [])]
     targets: dict[str, list[str]] = {}
-    for parent, child in [*jointed_pairs(robot), *always]:
+    for parent, child in [*jointed_pairs(robot), *excluded_pairs(robot)]:
         targets.setdefault(child, []).append(f"{root}/{prim_name(parent)}")
     for child, paths in targets.items():
         api = UsdPhysics.FilteredPairsAPI.Apply(stage.GetPrimAtPath(f"{root}/{prim_name(child)}"))

@@ -48,8 +48,8 @@ def adjacent(robot) -> set[tuple[str, str]]:
 
 def model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=collision_shapes) -> str:
     """The search's collision-only MJCF (scratch.py): geoms from `shapes_of(link)` with half
-    the clearance as margin each, joined links and `also_excluded` pairs excluded, no
-    parent filter."""
+    the clearance as margin each, joined links, the pairs the source excludes
+    (`contact_excludes`) and `also_excluded` pairs excluded, no parent filter."""
     margin = text([CLEARANCE / 2])  # MuJoCo adds the two geoms' margins
     scratch = Scratch(
         compiler={"angle": "radian"},
@@ -57,7 +57,7 @@ def model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=collis
         flags={"filterparent": "disable"},
     )
     scratch.tree(robot, base_dir, shapes_of)
-    scratch.exclude(sorted(adjacent(robot) | set(also_excluded)))
+    scratch.exclude(sorted(adjacent(robot) | set(also_excluded) | set(robot.contact_excludes)))
     return scratch.xml()
 
 
@@ -132,9 +132,28 @@ def always_touching(
     no pose can or need separate them; the search must not try, or it never moves the pair it
     could fix."""
     movable = robot.movable_joints
-    model, data, adr = compiled(model_xml(robot, base_dir, shapes_of=shapes_of), movable)
+    xml = model_xml(robot, base_dir, shapes_of=shapes_of)
+    key = (xml, np.asarray(start, dtype=float).tobytes(), robot.seed, _motion(movable))
+    if key not in _ALWAYS:  # the home search and its checks ask again for the same model
+        if len(_ALWAYS) >= 16:
+            _ALWAYS.clear()
+        _ALWAYS[key] = _always_touching(xml, movable, robot.seed, start, follow)
+    return _ALWAYS[key]
+
+
+#: always_touching's answers by (model text, first guess, seed, joints' limits and mimics)
+_ALWAYS: dict[tuple, tuple] = {}
+
+
+def _motion(movable) -> tuple:
+    """What the random configurations depend on besides the seed: limits and mimics."""
+    return tuple((j.name, j.lower, j.upper, j.mimic) for j in movable)
+
+
+def _always_touching(xml: str, movable, seed: int, start: np.ndarray, follow) -> tuple:
+    model, data, adr = compiled(xml, movable)
     pairs = contacts(model, data, adr, start)
-    rng = np.random.default_rng(robot.seed)
+    rng = np.random.default_rng(seed)
     low = np.array([j.lower if j.lower is not None else -math.pi for j in movable])
     high = np.array([j.upper if j.upper is not None else math.pi for j in movable])
     allowed = ALWAYS_SAMPLES - math.ceil(ALWAYS_FRACTION * ALWAYS_SAMPLES - 1e-9)

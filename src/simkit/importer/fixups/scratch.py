@@ -12,6 +12,7 @@ derive/collision_pairs.py to share (docs/architecture.md).
 
 from __future__ import annotations
 
+import hashlib
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -28,6 +29,26 @@ KINDS = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}
 def text(values) -> str:
     """Numbers as MJCF text, full precision (repr)."""
     return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+#: a mesh's vertex text by (STL digest, scale): an import compiles a dozen scratch models of
+#: the same meshes, and reading, merging and printing a CAD mesh's vertices cost more than
+#: MuJoCo's compile of them; the bytes are the same either way
+_VERTEX_TEXT: dict[tuple[bytes, tuple[float, ...]], str] = {}
+_VERTEX_TEXT_MAX = 1024
+
+
+def mesh_text(path: Path, scale) -> str:
+    """The MJCF `vertex` text of the STL at `path` (merged vertices, scaled), computed once
+    per file content and scale."""
+    data = path.read_bytes()
+    key = (hashlib.sha256(data).digest(), tuple(float(v) for v in np.ravel(scale)))
+    found = _VERTEX_TEXT.get(key)
+    if found is None:
+        if len(_VERTEX_TEXT) >= _VERTEX_TEXT_MAX:
+            _VERTEX_TEXT.clear()
+        found = _VERTEX_TEXT[key] = text(from_stl(data).vertices * scale)
+    return found
 
 
 def principal(tensor) -> dict[str, str]:
@@ -104,8 +125,8 @@ class Scratch:
         """One geom of a spec shape in the link frame (a cone: its bounding cylinder)."""
         attrs = {"pos": text(shape.xyz), "quat": text(quat_wxyz(rpy_matrix(shape.rpy)))}
         if shape.kind == "mesh":
-            vertices = from_stl((base_dir / shape.file).read_bytes()).vertices * shape.scale
-            ET.SubElement(self.asset, "mesh", name=name, vertex=text(vertices))
+            vertex = mesh_text(base_dir / shape.file, shape.scale)
+            ET.SubElement(self.asset, "mesh", name=name, vertex=vertex)
             attrs.update(type="mesh", mesh=name)
         elif shape.kind == "box":
             attrs.update(type="box", size=text(np.asarray(shape.size) / 2))
@@ -145,14 +166,27 @@ class Scratch:
         return ET.tostring(self.root, encoding="unicode")
 
 
+#: compiled scratch models by their MJCF's digest: the searches of one import compile the
+#: same collision model several times (the home search, the always-touching pairs, the
+#: limits); no caller changes a model, each gets its own data
+_COMPILED: dict[bytes, object] = {}
+_COMPILED_MAX = 8
+
+
 def compiled(xml: str, joints) -> tuple:
-    """(model, data, qpos address of each of `joints`) of a scratch MJCF. MuJoCo is imported
-    in a held section (kitio/interrupt.py): a signal that arrives while its extension
-    initialises would break that import (an ImportError, not the clean interruption), so it
-    takes effect once the import is done."""
+    """(model, data, qpos address of each of `joints`) of a scratch MJCF, compiled once per
+    text (a fresh MjData each call). MuJoCo is imported in a held section
+    (kitio/interrupt.py): a signal that arrives while its extension initialises would break
+    that import (an ImportError, not the clean interruption), so it takes effect once the
+    import is done."""
     with interrupt.held():
         import mujoco
 
-    model = mujoco.MjModel.from_xml_string(xml)
+    key = hashlib.sha256(xml.encode()).digest()
+    model = _COMPILED.get(key)
+    if model is None:
+        if len(_COMPILED) >= _COMPILED_MAX:
+            _COMPILED.clear()
+        model = _COMPILED[key] = mujoco.MjModel.from_xml_string(xml)
     adr = np.array([model.jnt_qposadr[model.joint(j.name).id] for j in joints], dtype=int)
     return model, mujoco.MjData(model), adr

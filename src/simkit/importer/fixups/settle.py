@@ -115,6 +115,7 @@ def model_xml(robot, base_dir: Path, home, excluded=()) -> str:
             frictionloss=repr(float(joint.friction)),
         )
     pairs = {(j.parent, j.child) for j in robot.joints if j.parent in bodies} | set(excluded)
+    pairs |= set(robot.contact_excludes)  # as the kit's MJCF
     scratch.exclude(sorted(pairs))
     equality = scratch.section("equality")
     for joint in robot.movable_joints:

@@ -45,11 +45,13 @@ def stance_shapes(link) -> tuple:
 
 def model_xml(robot, base_dir: Path) -> str:
     """Collision geometry only (scratch.py); every body but a fixed joint's child moves
-    (fixed children are welded, as MuJoCo does in the kit), the parent filter on."""
+    (fixed children are welded, as MuJoCo does in the kit), the parent filter on, the pairs
+    the source excludes (`contact_excludes`) excluded."""
     scratch = Scratch(compiler={"angle": "radian"}, geom={"contype": "1", "conaffinity": "1"})
     scratch.tree(robot, base_dir, stance_shapes)
     links = {link.name for link in robot.links}
-    scratch.exclude((j.parent, j.child) for j in robot.joints if j.parent in links)
+    jointed = [(j.parent, j.child) for j in robot.joints if j.parent in links]
+    scratch.exclude([*jointed, *robot.contact_excludes])
     return scratch.xml()
 
 

@@ -49,6 +49,11 @@ class MjcfSource(Source):
     files: dict[str, bytes] = field(default_factory=dict)
     #: (what, reason) of each element a kit cannot carry (translate/mjcf_listed.py)
     listed: list[tuple[str, str]] = field(default_factory=list)
+    #: (kind, compiled id) -> line in the model file of each body, geom, jnt and site
+    #: (`lines`): the report's records name it
+    lines: dict[tuple[str, int], int] = field(default_factory=dict)
+    #: the keys of `lines` that are an `<include>`'s line (shared by what it brings in)
+    included: set[tuple[str, int]] = field(default_factory=set)
 
 
 def _head(path: Path) -> bytes | None:
@@ -86,10 +91,11 @@ def read(shell: Source, options: ReadOptions) -> MjcfSource:
     source = MjcfSource(shell.path, None, shell.packages, shell.report)
     folder = shell.path.resolve().parent
     allowed = [folder, *(p.resolve() for p in options.allow_read)]
-    source.files = _confined(shell.path.resolve(), folder, allowed)
+    source.files, included = _confined(shell.path.resolve(), folder, allowed)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         source.spec, source.model = _compile(shell.path)
+    source.lines, source.included = lines(source.spec, source.model, included)
     for warning in caught:  # MuJoCo's own warnings (a deprecated attribute): one line each
         source.note(Position("mujoco", None), f"MuJoCo: {' '.join(str(warning.message).split())}")
     if source.model.nbody > MAX_BODIES:
@@ -117,19 +123,62 @@ def _inside(path: Path, folders: list[Path]) -> bool:
     return any(real == f or f in real.parents for f in folders)
 
 
-def _confined(main: Path, folder: Path, allowed: list[Path]) -> dict[str, bytes]:
+#: MjSpec element lists and the compiled kind (MjModel accessor) of each
+KINDS = (("bodies", "body"), ("geoms", "geom"), ("joints", "jnt"), ("sites", "site"))
+#: compiled id -> body id, per kind (a nameless element in an include takes its body's line)
+BODY_OF = {"geom": "geom_bodyid", "jnt": "jnt_bodyid", "site": "site_bodyid"}
+
+
+def lines(
+    spec, model, included: dict[tuple[str, str], int]
+) -> tuple[dict[tuple[str, int], int], set[tuple[str, int]]]:
+    """(kind, compiled id) -> line in the model file, and the keys whose line is an
+    `<include>`'s. MuJoCo's parser records each element's line (`info`, "line N"), but 0 for
+    one read from an `<include>`: that one gets the line of the `<include>` in the model file
+    that brought its name in (`included`, by tag and name), else its body's line."""
+    tags = {"body": "body", "geom": "geom", "jnt": "joint", "site": "site"}
+    out: dict[tuple[str, int], int] = {}
+    shared: set[tuple[str, int]] = set()
+    for listed, kind in KINDS:
+        for element in getattr(spec, listed):
+            found = re.fullmatch(r"line (\d+)", element.info or "")
+            line = int(found.group(1)) if found else 0
+            if not line and (tags[kind], element.name) in included:
+                line = included[(tags[kind], element.name)]
+                shared.add((kind, int(element.id)))
+            if line and element.id >= 0:
+                out[(kind, int(element.id))] = line
+    for kind, body_of in BODY_OF.items():
+        for i in range(int(getattr(model, f"n{kind}"))):
+            body = ("body", int(getattr(model, body_of)[i]))
+            if (kind, i) not in out and body in out:
+                out[(kind, i)] = out[body]
+                if body in shared:
+                    shared.add((kind, i))
+    return out, shared
+
+
+def _confined(
+    main: Path, folder: Path, allowed: list[Path]
+) -> tuple[dict[str, bytes], dict[tuple[str, str], int]]:
     """Every file the model names, checked to lie inside `allowed` (the model's folder and
-    --allow-read folders) and under the caps, read once: relative path -> bytes."""
+    --allow-read folders) and under the caps, read once: relative path -> bytes; and each
+    named element of an included file, (tag, name) -> the line of the `<include>` in the
+    model file that brings it in."""
     files: dict[str, bytes] = {}
+    included: dict[tuple[str, str], int] = {}
     total = [0]
     roots: list[tuple[Path, object]] = []
     count = 0
-    pending = [(main, (str(main), None))]
+    pending = [(main, (str(main), None), None)]
     while pending:
-        path, where = pending.pop(0)
+        path, where, top = pending.pop(0)  # top: the model file's <include> line, if any
         data = _read(path, where, MAX_XML, folder, allowed, files, total)
         root = _parse(path, data, where)
         roots.append((path, root))
+        for element in root.iter() if top else ():
+            if isinstance(element.tag, str) and element.get("name"):
+                included.setdefault((element.tag, element.get("name")), top)
         count += sum(1 for _ in root.iter())
         if count > MAX_ELEMENTS:
             raise SpecError(str(path), None, "xml", f"over {MAX_ELEMENTS} elements")
@@ -140,7 +189,11 @@ def _confined(main: Path, folder: Path, allowed: list[Path]) -> dict[str, bytes]
             if len(roots) + len(pending) >= MAX_INCLUDES:
                 raise SpecError(str(path), inc.sourceline, inc.tag, f"over {MAX_INCLUDES} includes")
             pending.append(
-                (_within(folder / name, path, inc, allowed), (str(path), inc.sourceline))
+                (
+                    _within(folder / name, path, inc, allowed),
+                    (str(path), inc.sourceline),
+                    top or inc.sourceline,
+                )
             )
     dirs = {""}
     for path, root in roots:
@@ -162,7 +215,7 @@ def _confined(main: Path, folder: Path, allowed: list[Path]) -> dict[str, bytes]
                     if candidate.is_file():
                         _read(candidate, (str(path), element.sourceline), MAX_ASSET, folder,
                               allowed, files, total)  # fmt: skip
-    return files
+    return files, included
 
 
 def _within(candidate: Path, path: Path, element, allowed: list[Path], attr: str = "file") -> Path:

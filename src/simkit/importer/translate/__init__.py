@@ -18,7 +18,16 @@ from pathlib import Path
 
 from simkit.importer.draft import Draft
 from simkit.importer.read.mjcf import MjcfSource
-from simkit.importer.translate import base, blocks, convert, declare, meshes, mjcf, names
+from simkit.importer.translate import (
+    base,
+    blocks,
+    convert,
+    declare,
+    meshes,
+    mjcf,
+    mjcf_excludes,
+    names,
+)
 from simkit.importer.translate.step_budget import step_fits
 from simkit.importer.translate.up_axis import turn_y_up
 
@@ -76,6 +85,8 @@ def _translate(draft: Draft) -> None:
     )  # fmt: skip
     renames = names.make_legal(spec, source, report)
     draft.renames = renames
+    if isinstance(source, MjcfSource):  # the source's contact excludes (mjcf_excludes.py)
+        draft.kept.listed = [*draft.kept.listed, *mjcf_excludes.carry(spec, source, renames)]
     blocks.keep(spec, source, report, blocks.collect(source), renames)
     report.raise_refused()
     fits, why = step_fits(spec, draft.stage)

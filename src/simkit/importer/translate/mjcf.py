@@ -69,8 +69,10 @@ def offsets(model) -> np.ndarray:
     return out
 
 
-def robot_root(model, path: Path) -> int:
-    """The one top-level body carrying joints; one line for none or several."""
+def robot_root(model, path: Path, lines: dict | None = None) -> int:
+    """The one top-level body carrying joints; one line for none or several (at the
+    second robot's body, or the misplaced free joint, where `lines` knows it)."""
+    lines = lines or {}
     tops: dict[int, int] = {}
     for j in range(model.njnt):
         top = int(model.body_rootid[model.jnt_bodyid[j]])
@@ -82,14 +84,14 @@ def robot_root(model, path: Path) -> int:
     if len(tops) > 1:
         names = ", ".join(name_of(model, "body", b) for b in sorted(tops))
         raise SpecError(
-            str(path), None, "worldbody",
+            str(path), lines.get(("body", sorted(tops)[1])), "worldbody",
             f"several robots (top-level bodies with joints: {names}): import one per file",
         )  # fmt: skip
     for j in range(model.njnt):
         body = int(model.jnt_bodyid[j])
         if model.jnt_type[j] == FREE and (body not in tops or model.body_jntnum[body] != 1):
             raise SpecError(
-                str(path), None, f"joint {name_of(model, 'jnt', j)}",
+                str(path), lines.get(("jnt", j)), f"joint {name_of(model, 'jnt', j)}",
                 "a free joint below the top-level body (or beside other joints): not a robot",
             )  # fmt: skip
     return next(iter(tops))
@@ -101,7 +103,7 @@ def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple
     from lxml import etree
 
     model = source.model
-    root_body = robot_root(model, source.path)
+    root_body = robot_root(model, source.path, source.lines)
     off = offsets(model)
     names = Names(model)
     robot = etree.Element("robot", name=model.names[: model.names.find(b"\0")].decode() or "robot")
@@ -121,7 +123,33 @@ def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple
         _sites(robot, model, body, names, off[body])
     why = "added: a link between two joints of one MJCF body"
     listed += [(f"links.{name}", why) for name in added]
+    _lines(robot, source, root_body)
     return robot, bool(floating), listed
+
+
+def _lines(robot, source: MjcfSource, root_body: int) -> None:
+    """Each element's `sourceline`: the MJCF line of the body, joint, geom or site it comes
+    from (read/mjcf.py `lines`, recorded in the `mjcf` attribute as KIND:ID), else its
+    parent element's; the `<robot>` the root body's. The report's records name it, and
+    provenance finds an element's records by line and element: so an element without a
+    name (a visual, a joint's limit) brought in by an `<include>`, whose line all it brings
+    in share, gets none."""
+    robot.sourceline = source.lines.get(("body", root_body)) or 0  # 0: none known
+    shared = set()
+    for element in robot.iter():
+        if element is robot:
+            continue
+        kind, _, index = (element.attrib.pop("mjcf", "") or ":").partition(":")
+        key = (kind, int(index)) if index else None
+        parent = element.getparent()
+        line = source.lines.get(key) if key else None
+        if key in source.included or (key is None and parent in shared):
+            shared.add(element)
+        if line is None and parent not in shared:
+            line = parent.sourceline
+        if element in shared and element.get("name") is None:
+            line = None
+        element.sourceline = line or 0
 
 
 class Names:
@@ -145,7 +173,7 @@ def _link(robot, model, body: int, name: str, off: np.ndarray) -> object:
     """`<link>` with its inertial (mass kg, CoM m and principal axes in the link frame)."""
     from lxml import etree
 
-    link = etree.SubElement(robot, "link", name=name)
+    link = etree.SubElement(robot, "link", name=name, mjcf=f"body:{body}")
     if model.body_mass[body] > 0:
         inertial = etree.SubElement(link, "inertial")
         etree.SubElement(
@@ -183,6 +211,7 @@ def _joints(robot, model, body: int, names: Names, off: np.ndarray) -> list[str]
     if count == 0:
         joint = etree.SubElement(robot, "joint", name=names.new(f"{names.links[body]}_joint"))
         joint.set("type", "fixed")
+        joint.set("mjcf", f"body:{body}")
         _origin(joint, pose_xyz, mat)
         etree.SubElement(joint, "parent", link=parent_link)
         etree.SubElement(joint, "child", link=names.links[body])
@@ -194,9 +223,9 @@ def _joints(robot, model, body: int, names: Names, off: np.ndarray) -> list[str]
             child = names.links[body]
         else:
             child = names.new(f"{name_of(model, 'jnt', j)}_link")
-            etree.SubElement(robot, "link", name=child)
+            etree.SubElement(robot, "link", name=child, mjcf=f"jnt:{j}")
             added.append(child)
-        joint = etree.SubElement(robot, "joint", name=name_of(model, "jnt", j))
+        joint = etree.SubElement(robot, "joint", name=name_of(model, "jnt", j), mjcf=f"jnt:{j}")
         turn, shift = _at_zero(model, j, kind)
         if k == 0:
             _origin(joint, pose_xyz + mat @ (at + shift), mat @ turn)
@@ -266,7 +295,7 @@ def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
             if model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0
             else "collision"
         )
-        element = etree.SubElement(link, tag)
+        element = etree.SubElement(link, tag, mjcf=f"geom:{g}")
         _origin(element, model.geom_pos[g] - off, quat_mat(model.geom_quat[g]))
         geometry = etree.SubElement(element, "geometry")
         size = model.geom_size[g]
@@ -319,7 +348,8 @@ def _sites(robot, model, body: int, names: Names, off: np.ndarray) -> None:
             continue
         name = names.new(model.site(s).name)
         joint = etree.SubElement(robot, "joint", name=names.new(f"{name}_joint"), type="fixed")
+        joint.set("mjcf", f"site:{s}")
         _origin(joint, model.site_pos[s] - off, quat_mat(model.site_quat[s]))
         etree.SubElement(joint, "parent", link=names.links[body])
         etree.SubElement(joint, "child", link=name)
-        etree.SubElement(robot, "link", name=name)
+        etree.SubElement(robot, "link", name=name, mjcf=f"site:{s}")

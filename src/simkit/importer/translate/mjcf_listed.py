@@ -2,9 +2,10 @@
 joint effort its actuators give.
 
 A kit carries a robot's links, joints, frames, geometry and one servo per joint; MuJoCo's
-tendons, equality constraints, cameras, lights, keyframes, sensors, contact pairs and
-excludes, actuators that drive anything but one joint, and its own servo gains have no
-place in the spec. Each is listed with its reason (key `KIND.NAME`), never dropped silently.
+tendons, equality constraints, cameras, lights, keyframes, sensors, contact pairs,
+actuators that drive anything but one joint, and its own servo gains have no place in the
+spec. Each is listed with its reason (key `KIND.NAME`), never dropped silently. Contact
+excludes are carried (mjcf_excludes.py).
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ KINDS = (
     ("nkey", "key", "keyframes", "a kit's poses are its own (home and the named poses)"),
     ("nsensor", "sensor", "sensors", "a kit's MuJoCo sensors are its own"),
     ("npair", "pair", "contact_pairs", "a kit's contact pairs are its own (self-collision)"),
-    ("nexclude", "exclude", "contact_excludes", "a kit's contact excludes are its own"),
     ("nskin", "skin", "skins", "a kit carries no skins"),
     ("nflex", "flex", "flexes", "a kit has no deformable bodies"),
 )

@@ -12,7 +12,6 @@ from pathlib import PurePosixPath
 
 from simkit.errors import SpecError
 from simkit.importer.fixups import collide, settle
-from simkit.importer.fixups.scratch import compiled
 from simkit.importer.read.mjcf import MjcfSource
 
 
@@ -45,42 +44,6 @@ def _main_key(source: MjcfSource) -> str:
     return source.path.name
 
 
-def refuse_excluded_contact(draft, source: MjcfSource) -> None:
-    """One line when two bodies the MJCF excludes from contact (`<exclude>`) still touch at
-    the kit's home: a kit excludes only adjacent links (and pairs touching everywhere), so
-    its contact checks would fail on a pair the source lets overlap. Links collide as in
-    the import's home search (fixups/collide.py: collision hulls and the visual pieces they
-    are grown to cover)."""
-    model = source.model
-    if not model.nexclude:
-        return
-    robot = draft.robot()
-    start, follow = collide.posed(robot)
-    if start is None:
-        return
-    renamed = draft.renames.get("links", {})
-    excluded = set()
-    for e in range(model.nexclude):
-        sig = int(model.exclude_signature[e])
-        a, b = (model.body(i).name for i in (sig >> 16, sig & 0xFFFF))
-        a, b = renamed.get(a, a), renamed.get(b, b)
-        excluded.add((a, b) if a < b else (b, a))
-    xml = collide.model_xml(robot, draft.stage, shapes_of=collide.covered_shapes)
-    built, data, adr = compiled(xml, robot.movable_joints)
-    touching = collide.contacts(built, data, adr, start) & excluded
-    if touching:  # pairs touching almost everywhere: the kit excludes them too
-        shapes = collide.covered_shapes
-        touching -= set(collide.always_touching(robot, draft.stage, start, follow, shapes))
-    touching = sorted(touching)
-    if touching:
-        a, b = touching[0]
-        raise SpecError(
-            str(source.path), None, "contact.exclude",
-            f"bodies {a} and {b} touch at the kit's home: the MJCF excludes the pair from "
-            "contact, a kit cannot carry that (it excludes adjacent links only)",
-        )  # fmt: skip
-
-
 #: m the base may sink while the kit's servos hold home (check/legged.py's drift tolerance)
 DRIFT = 0.02
 
@@ -89,7 +52,9 @@ def refuse_falling(draft, source: MjcfSource) -> None:
     """One line when a floating MJCF robot does not stand on the kit's servos: its base,
     started on the floor at home, sinks more than `DRIFT` in the import's settle run
     (fixups/settle.py: its collision geometry, real masses, servos as the kit's). An RL
-    model made to fall (a humanoid on round feet) would fail the kit's standing check."""
+    model made to fall (a humanoid on round feet) would fail the kit's standing check. The
+    line names the construct: a free base that needs active balance (and, where the MJCF
+    drives its joints by torque `<motor>`s, says so), at the free joint's line."""
     if not draft.floating:
         return
     robot = draft.robot()
@@ -99,8 +64,16 @@ def refuse_falling(draft, source: MjcfSource) -> None:
     settler = settle.Settler(robot, draft.stage, start, follow)
     height, rest = settler.height(start), settler.run(start)
     if height - rest.xyz[2] > DRIFT:
+        model = source.model
+        free = [j for j in range(model.njnt) if model.jnt_type[j] == 0]
+        motors = any(
+            model.actuator_gaintype[a] == 0 and model.actuator_biastype[a] == 0
+            for a in range(model.nu)
+        )
+        why = "torque <motor>s drive its joints; " if motors else ""
         raise SpecError(
-            str(source.path), None, "freejoint",
-            f"the floating robot does not stand on a kit's servos at home: its base sinks "
-            f"{height - rest.xyz[2]:.2f} m in {settle.SECONDS:g} s (a kit must hold its pose)",
+            str(source.path), source.lines.get(("jnt", free[0])) if free else None, "freejoint",
+            f"a free base that needs active balance: on a kit's position servos at home it "
+            f"sinks {height - rest.xyz[2]:.2f} m in {settle.SECONDS:g} s ({why}a kit carries "
+            "no balance controller)",
         )  # fmt: skip

@@ -58,7 +58,6 @@ def keep(draft) -> None:
 
     original = draft.kept
     if isinstance(original, MjcfSource):  # the MJCF as read and its files (mjcf_source.py)
-        mjcf_source.refuse_excluded_contact(draft, original)
         mjcf_source.refuse_falling(draft, original)
         spec = draft.spec
         spec["source"] = mjcf_source.keep(draft, original)
