@@ -19,6 +19,7 @@ from mjcf_models import listed, spec_of, write
 from simkit.check.kit import Kit
 from simkit.check.source import check_source
 from simkit.errors import SpecError
+from simkit.kitio import layout
 from simkit.spec.validate import load_spec
 
 LINK = '<inertial pos="0 0 0.03" mass="0.05" diaginertia="2e-5 2e-5 5e-6"/>'
@@ -71,7 +72,7 @@ def test_every_format_gets_the_pair_and_the_kit_passes(imported, tmp_path):
     assert '<disable_collisions link1="finger" link2="thumb" reason="User" />' in srdf
     doc = json.loads((kit / "robot.json").read_text())
     assert doc["collision_pairs"]["declared"] == [["finger", "thumb"]]
-    stage = Usd.Stage.Open(str(kit / "usd/payloads/physics.usda"))
+    stage = Usd.Stage.Open(str(kit / layout.usd_payload("hand", "physics.usda")))
     filtered = {
         (prim.GetName(), target.name)
         for prim in stage.TraverseAll()
