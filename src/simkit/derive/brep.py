@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from simkit.derive.facets import MM
+from simkit.derive.facets import MM, faceted_solid
 from simkit.derive.mesh_brep import Plan, mesh_shape, mesh_solid
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Link, Shape
@@ -22,7 +22,7 @@ from simkit.model.robot import Link, Shape
 if TYPE_CHECKING:
     from OCP.TopoDS import TopoDS_Shape
 
-__all__ = ["link_shape", "mesh_solid", "primitive_shape", "step_shape", "trsf"]
+__all__ = ["faceted_solid", "link_shape", "mesh_solid", "primitive_shape", "step_shape", "trsf"]
 
 
 def trsf(matrix: np.ndarray, scale: float = MM) -> Any:
