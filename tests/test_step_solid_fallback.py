@@ -113,3 +113,19 @@ def test_the_check_excuses_only_the_links_robot_json_lists(tmp_path, listed, sol
     found = {f.check: f for f in check_step(Kit.open(kit))}
     assert found["step.products"].ok is passes
     assert found["step.brepcheck"].ok and found["step.volume"].ok
+
+
+def test_robot_json_and_the_readme_list_a_left_out_link():
+    from simkit.emit import docs, robot_json
+
+    robot = model_from_spec(PLANAR)
+    assert "left_out" not in robot_json.step_geometry(robot)  # none: the seed kits' bytes
+    why = [{"link": "link_2", "why": "no valid STEP solid: made up for the test"}]
+    robot = dataclasses.replace(
+        robot, products=dataclasses.replace(robot.products, step_left_out=why)
+    )
+    assert robot_json.step_geometry(robot)["left_out"] == why
+    readme = docs.emit(robot)[layout.README].decode()
+    assert "Left out of the STEP assembly: `link_2` (no valid STEP solid: made up" in readme
+    text = step.step_bytes(robot).decode()
+    assert "PRODUCT('link_1','link_1'" in text and "PRODUCT('link_2'" not in text
