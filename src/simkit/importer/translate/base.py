@@ -130,9 +130,15 @@ def legs(source: Source) -> tuple[list[list[str]], str]:
             f"'{root}' at the zero pose (legs; at least {drop:.3g} m, {LEG:g} of the "
             f"robot's {span:.3g} m height)"
         )
+    hands = sum(hand for d, _limb, hand in limbs if d >= drop)
     return found, (
-        f"{len(found)} of {len(limbs)} limbs reach {drop:.3g} m below it at the zero pose; "
-        "two would be legs"
+        f"{len(found) + hands} of {len(limbs)} limbs reach {drop:.3g} m below it at the zero "
+        "pose; two would be legs"
+        + (
+            f", but {hands} of them branch into fingers (hands, no legs)"
+            if hands and len(found) + hands >= 2
+            else ""
+        )
     )
 
 
