@@ -1,8 +1,9 @@
 """Legged checks only on robots that stand (issue 32, class 7). Small URDFs made for the
 purpose: a torso whose two arms hang below it at the zero pose, each ending in a two-finger
 gripper (arms, not legs: fixed base); the same torso without grippers bolted to `world` by
-a fixed joint (fixed base); a biped whose leg meshes are all missing (nothing of its own to
-stand on: fixed base, said in one line); the biped with its boxes (floating, as before)."""
+a fixed joint (fixed base); a biped whose legs have no geometry at all (it would fall
+through the floor: fixed base, said in one line); the biped with its leg meshes missing
+(estimated boxes) or with its boxes (floating, as before)."""
 
 from __future__ import annotations
 
@@ -34,14 +35,21 @@ def _robot(*parts: str) -> str:
     return '<?xml version="1.0"?>\n<robot name="rig">\n' + "\n".join(parts) + "\n</robot>\n"
 
 
-def _limbs(names: tuple[str, str], fingers: bool, missing: bool = False) -> list[str]:
-    """Two limbs of upper, lower and end links hanging 0.9 m below the root `torso`."""
+def _bare(name: str) -> str:
+    """A link of an inertial only: no `<visual>`, no `<collision>`."""
+    return _link(name).split("<visual>")[0] + "</link>"
+
+
+def _limbs(names: tuple[str, str], fingers: bool, legs: str = "boxes") -> list[str]:
+    """Two limbs of upper, lower and end links hanging 0.9 m below the root `torso`; `legs`:
+    their geometry, "boxes", "missing" meshes or "none" (inertials only)."""
     parts = []
     for side, y in (("l", 0.15), ("r", -0.15)):
         upper, lower = f"{side}_{names[0]}", f"{side}_{names[1]}"
         for name in (upper, lower, f"{side}_end"):
             mesh = f'<mesh filename="meshes/{name}.stl"/>'
-            parts.append(_link(name, mesh) if missing else _link(name))
+            made = {"boxes": _link(name), "missing": _link(name, mesh), "none": _bare(name)}
+            parts.append(made[legs])
         parts += [
             _joint(f"{side}_1", "torso", upper, f"0 {y} -0.1"),
             _joint(f"{side}_2", upper, lower, "0 0 -0.3"),
@@ -78,10 +86,15 @@ def test_a_robot_bolted_to_world_by_a_fixed_joint_is_fixed(tmp_path):
     assert not floating and "bolts the robot to 'world' with a fixed joint" in line
 
 
-def test_a_biped_whose_leg_meshes_are_all_missing_is_bolted_and_says_why(tmp_path):
-    text = _robot(TORSO, *_limbs(("thigh", "shin"), False, missing=True))
+def test_a_biped_whose_legs_have_no_geometry_is_bolted_and_says_why(tmp_path):
+    text = _robot(TORSO, *_limbs(("thigh", "shin"), False, legs="none"))
     floating, line = _base(tmp_path, text)
-    assert not floating and "none of their links has geometry of its own" in line
+    assert not floating and "none of their links has a <visual> or <collision>" in line
+
+
+def test_a_biped_whose_leg_meshes_are_missing_stands_on_estimated_boxes(tmp_path):
+    floating, line = _base(tmp_path, _robot(TORSO, *_limbs(("thigh", "shin"), False, "missing")))
+    assert floating and "floating base: 2 limbs reach" in line
 
 
 def test_a_biped_with_its_geometry_still_floats(tmp_path):
@@ -90,12 +103,15 @@ def test_a_biped_with_its_geometry_still_floats(tmp_path):
 
 
 @pytest.mark.slow
-def test_the_two_arm_rig_builds_and_passes_its_checks(tmp_path):
+@pytest.mark.parametrize(
+    "limbs", [(("upper_arm", "forearm"), True, "boxes"), (("thigh", "shin"), False, "none")]
+)
+def test_the_rig_and_the_bare_biped_build_and_pass_their_checks(tmp_path, limbs):
     from simkit.pipeline import build
 
     urdf = tmp_path / "rig.urdf"
-    urdf.write_text(_robot(TORSO, *_limbs(("upper_arm", "forearm"), True)))
+    urdf.write_text(_robot(TORSO, *_limbs(*limbs)))
     done = import_robot(urdf, tmp_path / "out")
     result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
-    assert all(f.ok for f in result.findings)
+    assert result.findings and all(f.ok for f in result.findings)
     assert not any(f.check.startswith("legged.") for f in result.findings)

@@ -15,8 +15,9 @@ Arms are no legs (issue 32, class 7): a limb with a link that carries two or mor
 branches (a gripper's or hand's fingers) is an arm, and a robot whose root is `world` (the
 URDF convention for the world frame, which Gazebo, Drake and PyBullet weld) joined to the
 robot by a fixed joint is bolted there by its author: a rig with two arms hanging from its
-torso stands on neither. A robot whose legs have no geometry at all (their meshes missing)
-cannot stand on them: `standable` tells the translation, which then bolts it at the root.
+torso stands on neither. A robot whose legs have no geometry at all (no `<visual>` or
+`<collision>` on any of their links) would fall through the floor: `standable` tells the
+translation, which then bolts it at the root.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ import numpy as np
 
 from simkit.importer.read.source import Source
 from simkit.importer.translate.convert import tree
-from simkit.importer.translate.geometry import origin, usable
+from simkit.importer.translate.geometry import origin
 from simkit.model.kinematics import rpy_matrix
 
 #: share of the robot's height span (z at the zero pose) a leg reaches below the root
@@ -169,15 +170,14 @@ def decide(source: Source) -> tuple[bool, str]:
 
 #: the report line of a robot with legs and no geometry on them
 UNSTANDABLE = (
-    "fixed base: legs, but none of their links has geometry of its own to stand on (every "
-    "mesh is missing; a box the import estimates is a guess), so the floor could not be "
-    "trusted to hold it: bolted at the root link; --floating-base frees it"
+    "fixed base: legs, but none of their links has a <visual> or <collision>, so nothing "
+    "would meet the floor: bolted at the root link; --floating-base frees it"
 )
 
 
 def standable(source: Source) -> bool:
-    """True when some link of the legs has a `<visual>` or `<collision>` whose geometry the
-    import can read (a primitive, or a mesh some rule finds) for the floor to hold."""
+    """True when some link of the legs has a `<visual>` or `<collision>` for the floor to
+    hold (one whose mesh is missing still gets an estimated box: importer/solids.py)."""
     links = tree(source)[0]
     names = {n for leg in legs(source)[0] for n in leg}
-    return any(usable(source, element) for n in names for element in links[n])
+    return any(element.tag in ("visual", "collision") for n in names for element in links[n])

@@ -135,7 +135,7 @@ def _missing(source: Source, element, shape, why: str, what: str):
     """A mesh no rule finds: this geometry is left out (as PyBullet does), reported; a link
     left with no geometry at all gets an estimated box instead (importer/translate/solids.py)."""
     link = element.getparent()
-    if any(usable(source, other) for other in link if other is not element):
+    if any(_usable(source, other) for other in link if other is not element):
         source.lenient(shape, f"{why}: this {what} is left out")
         return None
     box = _estimated_box(source, link)
@@ -147,7 +147,7 @@ def _missing(source: Source, element, shape, why: str, what: str):
     return box, None
 
 
-def usable(source: Source, element) -> bool:
+def _usable(source: Source, element) -> bool:
     """Whether a `<visual>`/`<collision>` has geometry other than a mesh no rule finds."""
     if element.tag not in ("visual", "collision"):
         return False
