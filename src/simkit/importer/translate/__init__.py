@@ -65,8 +65,6 @@ def _translate(draft: Draft) -> None:
     floating = options.floating
     if floating is None:
         floating = draft.legged
-        if floating and not base.standable(source):
-            floating, why = False, base.UNSTANDABLE  # nothing for the floor to hold
         report.assumed(source, source.root, why)
     mesh_writer = meshes.MeshWriter(draft.stage)
     mesh_writer.turn_y_up, why = turn_y_up(source)  # Y_UP COLLADA meshes drawn so: turned

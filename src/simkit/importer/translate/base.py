@@ -15,9 +15,8 @@ Arms are no legs (issue 32, class 7): a limb with a link that carries two or mor
 branches (a gripper's or hand's fingers) is an arm, and a robot whose root is `world` (the
 URDF convention for the world frame, which Gazebo, Drake and PyBullet weld) joined to the
 robot by a fixed joint is bolted there by its author: a rig with two arms hanging from its
-torso stands on neither. A legged robot with no geometry at all (no `<visual>` or
-`<collision>` on any link) would fall through the floor: `standable` tells the translation,
-which then bolts it at the root.
+torso stands on neither. (Legs whose meshes are missing, or a URDF with no geometry at all,
+stand on the boxes the import estimates: translate/solids.py.)
 """
 
 from __future__ import annotations
@@ -165,22 +164,4 @@ def decide(source: Source) -> tuple[bool, str]:
     return False, (
         f"fixed base: the root link '{root}' is bolted to the world ({figures}); "
         "--floating-base lets it move"
-    )
-
-
-#: the report line of a robot with legs and no geometry at all
-UNSTANDABLE = (
-    "fixed base: legs, but no link has a <visual> or <collision>, so nothing would meet the "
-    "floor: bolted at the root link; --floating-base frees it"
-)
-
-
-def standable(source: Source) -> bool:
-    """True when some link has a `<visual>` or `<collision>` for the floor to hold (one whose
-    mesh is missing still gets an estimated box: importer/solids.py; a body wide enough can
-    carry a robot whose legs are bare, as a corpus humanoid's does)."""
-    return any(
-        element.tag in ("visual", "collision")
-        for link in tree(source)[0].values()
-        for element in link
     )
