@@ -213,15 +213,15 @@ def test_urdf_without_inertials_gets_the_mass_of_its_solids(tmp_path):
     path = _no_inertials(tmp_path)
     done = import_robot(path, tmp_path / "out")
     links = {link["name"]: link for link in yaml.safe_load(done.spec_path.read_text())["links"]}
-    assert abs(links["base"]["mass"] - 2700 * 0.2 * 0.2 * 0.1) < 1e-6  # 10.8 kg of aluminium
-    assert abs(links["upper"]["mass"] - 2700 * 0.05 * 0.05 * 0.3) < 1e-6
-    assert abs(links["fore"]["mass"] - 2700 * 0.1 * 0.1 * 0.2) < 1e-3  # the mesh's volume
+    assert abs(links["base"]["mass"] - 1400 * 0.2 * 0.2 * 0.1) < 1e-6  # 5.6 kg (the median link)
+    assert abs(links["upper"]["mass"] - 1400 * 0.05 * 0.05 * 0.3) < 1e-6
+    assert abs(links["fore"]["mass"] - 1400 * 0.1 * 0.1 * 0.2) < 1e-3  # the mesh's volume
     assert abs(links["fore"]["com"][2] - 0.1) < 1e-6
     fore = links["fore"]["inertia"]  # a solid box: m (a^2 + b^2) / 12
-    assert abs(fore["ixx"] - 5.4 * (0.1**2 + 0.2**2) / 12) < 1e-6
+    assert abs(fore["ixx"] - 2.8 * (0.1**2 + 0.2**2) / 12) < 1e-6
     assert {"mass", "com", "inertia"} <= set(links["upper"]["estimated"])
     lines = [ln for ln in done.lines if "visual solid's volume" in ln]
-    assert len(lines) == 3 and all("2700 kg/m^3" in ln for ln in lines)
+    assert len(lines) == 3 and all("1400 kg/m^3" in ln for ln in lines)
     light = import_robot(path, tmp_path / "light", density=1000.0)
     links = {link["name"]: link for link in yaml.safe_load(light.spec_path.read_text())["links"]}
     assert abs(links["upper"]["mass"] - 1000 * 0.05 * 0.05 * 0.3) < 1e-6

@@ -9,7 +9,9 @@ must be within 1 % of the visual STL's (the STL is the same solid tessellated wi
 number of segments, so it holds slightly less; a removed or added piece shows here) and its
 bounding box within 1 mm of the STL's, both in the assembly origin frame at the zero pose.
 The STLs are in link frames: FK from robot.json's own joints (q = 0) places them, so a moved
-or missing link fails.
+or missing link fails. A link robot.json lists in `geometry.step.left_out` (with its reason:
+no valid solid could be made of its mesh, issue 32) must have no solid; any other missing
+solid fails.
 """
 
 from __future__ import annotations
@@ -158,7 +160,14 @@ def check_step(kit: Kit) -> list[Finding]:
         if link["mesh"]["visual"]
     }
     counts = {name: len(solids) for name, solids in parts.items()}
-    wrong = [f"{n}: no solid" for n in sorted(visuals) if not counts.get(n)]
+    left_out = {e.get("link"): e.get("why") for e in entry.get("left_out", [])}
+    wrong = [f"{n}: left out with no reason" for n in sorted(left_out) if not left_out[n]]
+    wrong += [f"{n}: left out, yet has solids" for n in sorted(left_out) if counts.get(n)]
+    wrong += [
+        f"{n}: left out, not a link with a mesh" for n in sorted(set(left_out) - set(visuals))
+    ]
+    visuals = {n: v for n, v in visuals.items() if n not in left_out}
+    wrong += [f"{n}: no solid" for n in sorted(visuals) if not counts.get(n)]
     # a product without solids that is no link is the empty assembly of a robot with no
     # geometry at all (an imported URDF of inertials only), which the reader sees as a leaf
     extra = sorted(n for n in set(counts) - set(visuals) if counts[n])
@@ -173,7 +182,9 @@ def check_step(kit: Kit) -> list[Finding]:
             "step.products",
             not wrong,
             f"one product per link with geometry, named as the link, holding its solids "
-            f"({len(visuals)} links; wrong: {', '.join(wrong) or 'none'})",
+            f"({len(visuals)} links; "
+            + (f"left out as robot.json says: {len(left_out)}; " if left_out else "")
+            + f"wrong: {', '.join(wrong) or 'none'})",
         ),
     ]
     invalid = [

@@ -31,7 +31,8 @@ from simkit.errors import SimkitError
     "--density",
     type=click.FloatRange(min=1.0, max=25000.0),
     default=None,
-    help="kg/m^3 of a massless link's visual solid, for its estimated mass. [default: 2700]",
+    help="kg/m^3 of a massless link's visual solid, for its estimated mass. [default: 1400, "
+    "the corpora's median link (docs/import-corpus.md)]",
 )
 @click.option(
     "--hull",

@@ -8,7 +8,16 @@ from collections.abc import Callable
 from dataclasses import fields, replace
 from pathlib import Path
 
-from simkit.derive import arm, collision_pairs, gpu_scene, mass, per_link, references, ros2_control
+from simkit.derive import (
+    arm,
+    collision_pairs,
+    gpu_scene,
+    mass,
+    per_link,
+    references,
+    ros2_control,
+    step_plan,
+)
 from simkit.kitio.cache import Cache, cached_stage, decode_plain, digest, encode_plain
 from simkit.model import dynamics
 from simkit.model.robot import Products, Robot
@@ -36,6 +45,7 @@ def derive_all(
     # last: both sample the final collision geometry, masses and servos
     robot = products_step(robot, cache, "collision_pairs", collision_pairs.derive_collision_pairs)
     robot = products_step(robot, cache, "gpu_scene", gpu_scene.derive_gpu_scene)
+    robot = products_step(robot, cache, "step_plans", step_plan.derive_step_plans)
     return products_step(robot, cache, "motion", arm.derive_motion)
 
 

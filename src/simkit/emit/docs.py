@@ -82,6 +82,7 @@ def context(robot: Robot) -> dict:
         "sources": list(robot.sources),
         "step": layout.step(robot.name),
         "step_origin": step_origin(robot),
+        "step_left_out": list(robot.products.step_left_out),
         "segments": CIRCULAR_SEGMENTS,
         **_floating(robot),
         **_gpu(robot),

@@ -313,8 +313,9 @@ def _segments(robot: Robot) -> str:
 
 
 def step_geometry(robot: Robot) -> dict:
-    """robot.json `geometry.step`: where the STEP assembly is and how it relates to the meshes."""
-    return {
+    """robot.json `geometry.step`: where the STEP assembly is and how it relates to the
+    meshes; `left_out` (only where there are some): links with no valid STEP solid."""
+    out = {
         "file": layout.step(robot.name),
         "format": "ISO 10303-21, AP214 (AUTOMOTIVE_DESIGN), millimetres",
         "origin": step_origin(robot),
@@ -325,6 +326,9 @@ def step_geometry(robot: Robot) -> dict:
         f"{_segments(robot)} per circle, so they hold a little less volume (under "
         "1 %); a link from a mesh file is the sewn faceted mesh",
     }
+    if robot.products.step_left_out:
+        out["left_out"] = [dict(entry) for entry in robot.products.step_left_out]
+    return out
 
 
 def emit(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, bytes]:

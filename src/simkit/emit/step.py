@@ -56,8 +56,13 @@ def _document(robot: Robot):
     assembly = shapes.NewShape()
     TDataStd_Name.Set_s(assembly, TCollection_ExtendedString(robot.name))
     poses = zero_poses(robot)
+    plans = robot.products.step_plans
+    left_out = {entry["link"] for entry in robot.products.step_left_out}
     for link in robot.links:
-        solid = brep.link_shape(link)
+        if link.name in left_out:
+            continue
+        plan = tuple(plans[link.name]) if link.name in plans else ()
+        solid = brep.step_shape(link, plan)[0]
         if solid is None:
             continue
         part = shapes.AddShape(solid, False)

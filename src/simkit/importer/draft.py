@@ -19,8 +19,11 @@ from simkit.model.resolve import resolve
 from simkit.model.robot import Robot
 from simkit.spec.schema import RobotSpec
 
-#: kg/m^3 of an estimated solid: aluminium (`--density` sets another)
-DENSITY = 2700.0
+#: kg/m^3 of an estimated solid (`--density` sets another): the median mass / visual volume
+#: of the 238 distinct links that give both in example-robot-data and pybullet_data (1373;
+#: quartiles 762 and 2712; `scripts/density_from_corpora.py`, docs/import-corpus.md class
+#: 6a). Most links are hollow shells, so aluminium's 2700 doubled an arm's mass.
+DENSITY = 1400.0
 
 
 class Unresolvable(Exception):

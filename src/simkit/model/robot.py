@@ -252,6 +252,10 @@ class Products:
     benchmark_trajectory: dict | None = None
     #: derive/gpu_scene.py: the GPU scene's colliders, contact pairs and sizes (mjcf/NAME_mjx.xml)
     gpu_scene: dict | None = None
+    #: derive/step_plan.py: the STEP candidate kept per piece of each mesh link that needed
+    #: checking ({link: [k, ...]}), and the links left out of the STEP ([{link, why}])
+    step_plans: dict = field(default_factory=dict)
+    step_left_out: list = field(default_factory=list)
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,13 @@ range (a wheel, on continuous joints only, is no leg: a two-wheeler does not sta
 make the base floating. Anything else keeps a fixed base (an arm bolted down, a wheeled
 base on a stand, a drone on a test rig). `--fixed-base` and `--floating-base` override the
 decision; the import reports it on one line either way.
+
+Arms are no legs (issue 32, class 7): a limb with a link that carries two or more movable
+branches (a gripper's or hand's fingers) is an arm, and a robot whose root is `world` (the
+URDF convention for the world frame, which Gazebo, Drake and PyBullet weld) joined to the
+robot by a fixed joint is bolted there by its author: a rig with two arms hanging from its
+torso stands on neither. (Legs whose meshes are missing, or a URDF with no geometry at all,
+stand on the boxes the import estimates: translate/solids.py.)
 """
 
 from __future__ import annotations
@@ -63,9 +70,10 @@ def _points(source: Source, links: dict, by_child: dict, root: str) -> dict[str,
     return out
 
 
-def _limbs(links: dict, by_child: dict, root: str) -> list[list[str]]:
+def _limbs(links: dict, by_child: dict, root: str) -> list[tuple[list[str], bool]]:
     """The links of each branch that leaves the root's welded frame through a movable joint
-    and has a joint with a range (revolute, prismatic, spherical: not only wheels)."""
+    and has a joint with a range (revolute, prismatic, spherical: not only wheels), each with
+    whether it is a hand (a link with two or more movable branches below it: fingers)."""
     kids: dict[str, list[str]] = {}
     for child, joint in by_child.items():
         kids.setdefault(joint.find("parent").get("link"), []).append(child)
@@ -78,6 +86,11 @@ def _limbs(links: dict, by_child: dict, root: str) -> list[list[str]]:
             stack.extend(kids.get(node, []))
         return out
 
+    def hand(limb: list[str]) -> bool:
+        return any(
+            sum(by_child[kid].get("type") in MOVABLE for kid in kids.get(n, [])) >= 2 for n in limb
+        )
+
     limbs, stack = [], [root]
     while stack:  # the welded frame: the root and what fixed joints hold to it
         node = stack.pop()
@@ -85,33 +98,70 @@ def _limbs(links: dict, by_child: dict, root: str) -> list[list[str]]:
             if by_child[child].get("type") in MOVABLE:
                 limb = below(child)
                 if any(by_child[n].get("type") in RANGED for n in limb):
-                    limbs.append(limb)
+                    limbs.append((limb, hand(limb)))
             else:
                 stack.append(child)
     return limbs
 
 
-def decide(source: Source) -> tuple[bool, str]:
-    """(floating, the report line's reason) from the URDF's structure."""
+#: the URDF convention for the world frame (Gazebo, Drake and PyBullet weld a `world` parent)
+WORLD = "world"
+
+
+def legs(source: Source) -> tuple[list[list[str]], str]:
+    """The limbs that are legs (their links), deepest first, and the figures of the report
+    line: how many limbs reach how far below the root, against which drop."""
     links, by_child, root = tree(source)
     points = _points(source, links, by_child, root)
     every = np.vstack(list(points.values()))
     span = float(every[:, 2].max() - every[:, 2].min())
     drop = max(LEG * span, MIN_DROP)
-    depths = sorted(
-        (-float(np.vstack([points[n] for n in limb if n in points])[:, 2].min()) for limb in
-         _limbs(links, by_child, root)),
-        reverse=True,
-    )  # fmt: skip
-    legs = [d for d in depths if d >= drop]
-    if len(legs) >= 2:
-        return True, (
-            f"floating base: {len(legs)} limbs reach {min(legs):.3g} m or more below the root "
-            f"link '{root}' at the zero pose (legs; at least {drop:.3g} m, {LEG:g} of the "
-            f"robot's {span:.3g} m height); --fixed-base bolts it at the root instead"
+    limbs = [
+        (-float(np.vstack([points[n] for n in limb if n in points])[:, 2].min()), limb, hand)
+        for limb, hand in _limbs(links, by_child, root)
+    ]
+    deep = sorted(
+        ((d, limb) for d, limb, hand in limbs if d >= drop and not hand), key=lambda x: -x[0]
+    )
+    found = [limb for _d, limb in deep]
+    if len(found) >= 2:
+        return found, (
+            f"{len(found)} limbs reach {deep[-1][0]:.3g} m or more below the root link "
+            f"'{root}' at the zero pose (legs; at least {drop:.3g} m, {LEG:g} of the "
+            f"robot's {span:.3g} m height)"
         )
+    hands = sum(hand for d, _limb, hand in limbs if d >= drop)
+    return found, (
+        f"{len(found) + hands} of {len(limbs)} limbs reach {drop:.3g} m below it at the zero "
+        "pose; two would be legs"
+        + (
+            f", but {hands} of them branch into fingers (hands, no legs)"
+            if hands and len(found) + hands >= 2
+            else ""
+        )
+    )
+
+
+def _bolted(source: Source) -> bool:
+    """True when the root is `world` and a fixed joint holds the robot to it."""
+    _links, by_child, root = tree(source)
+    return root == WORLD and any(
+        j.find("parent").get("link") == root and j.get("type") == "fixed" for j in by_child.values()
+    )
+
+
+def decide(source: Source) -> tuple[bool, str]:
+    """(floating, the report line's reason) from the URDF's structure."""
+    found, figures = legs(source)
+    root = tree(source)[2]
+    if len(found) >= 2 and _bolted(source):
+        return False, (
+            f"fixed base: the URDF bolts the robot to '{root}' with a fixed joint ({figures}); "
+            "--floating-base lets it move"
+        )
+    if len(found) >= 2:
+        return True, f"floating base: {figures}; --fixed-base bolts it at the root instead"
     return False, (
-        f"fixed base: the root link '{root}' is bolted to the world ({len(legs)} of "
-        f"{len(depths)} limbs reach {drop:.3g} m below it at the zero pose; two would be "
-        "legs); --floating-base lets it move"
+        f"fixed base: the root link '{root}' is bolted to the world ({figures}); "
+        "--floating-base lets it move"
     )

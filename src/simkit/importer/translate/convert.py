@@ -10,7 +10,7 @@ from simkit.importer.diagnostics import Report
 from simkit.importer.read.source import Source
 from simkit.importer.translate.ball_joints import expand as expand_ball_joints
 from simkit.importer.translate.geometry import floats
-from simkit.importer.translate.joints import joint_spec, mimic_limits
+from simkit.importer.translate.joints import first_leaders, joint_spec, mimic_limits
 from simkit.importer.translate.links import has_geometry, has_mass, link_spec
 from simkit.importer.translate.meshes import MeshWriter
 from simkit.importer.translate.solids import DENSITY, MAX_SIDE, add_solids
@@ -305,8 +305,10 @@ def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
                 element if element is not None else source.root,
                 f"mimic of '{mimic['joint']}', not a movable joint: imported as independent",
             )
-        elif mimic is not None:
-            mimic_limits(source, joint, movable[mimic["joint"]], report)
+    first_leaders(source, joints, report)
+    for joint in joints:
+        if "mimic" in joint:
+            mimic_limits(source, joint, movable[joint["mimic"]["joint"]], report)
 
 
 def _ancestors(tool: str | None, joints: list[dict], frames: list[dict]) -> set[str]:

@@ -191,3 +191,40 @@ def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> N
     joint["lower"], joint["upper"] = lower, upper
     done = joint.get("estimated", [])
     joint["estimated"] = [*done, *(k for k in keys if k not in done)]
+
+
+def first_leaders(source: Source, joints: list[dict], report: Report) -> None:
+    """A mimic of a mimic (an underactuated finger's tip following its middle joint, which
+    follows the knuckle) is rewritten to follow the first leader directly: f = a g + b and
+    g = c h + d give f = (a c) h + (a d + b), the same motion. URDF readers differ on such
+    chains (yourdfpy takes the middle joint's own configuration value, not its mimicked
+    one), so every kit file names a driven leader. A chain that loops is dropped (the joints
+    move independently). One report line per rewritten joint."""
+    by_name = {j["name"]: j for j in joints}
+    for joint in joints:
+        mimic, seen = joint.get("mimic"), {joint["name"]}
+        if mimic is None or "mimic" not in by_name.get(mimic["joint"], {}):
+            continue
+        multiplier, offset, leader = mimic["multiplier"], mimic["offset"], mimic["joint"]
+        while "mimic" in by_name[leader] and leader not in seen:
+            seen.add(leader)
+            step = by_name[leader]["mimic"]
+            multiplier, offset = (
+                multiplier * step["multiplier"],
+                multiplier * step["offset"] + offset,
+            )
+            leader = step["joint"]
+        element = source.root.find(f"joint[@name='{joint['name']}']/mimic")
+        element = element if element is not None else source.root
+        if leader in seen:
+            del joint["mimic"]
+            joint.pop("actuated", None)
+            report.dropped(source, element, f"mimic chain loops back to '{leader}': independent")
+            continue
+        report.changed(
+            source,
+            element,
+            f"mimic of '{mimic['joint']}', itself a mimic: follows '{leader}' x {multiplier:g} "
+            f"+ {offset:g} (the same motion)",
+        )
+        joint["mimic"] = {**mimic, "joint": leader, "multiplier": multiplier, "offset": offset}

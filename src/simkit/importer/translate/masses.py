@@ -2,7 +2,8 @@
 
 A URDF without `<inertial>` elements would otherwise become a robot of 1 g links (a 7 g
 industrial arm that the kit's servos fling about). A massless link with a visual solid gets
-the mass of that solid at `draft.DENSITY` (aluminium, `--density` sets another): the volume of each
+the mass of that solid at `draft.DENSITY` (1400 kg/m^3, the corpora's median link; `--density`
+sets another): the volume of each
 visual piece (the closed mesh the importer writes, or the convex hull it writes for an open
 mesh; primitives exactly), its centre of mass and its inertia, summed about the link's CoM.
 Which links: every link with a solid when the URDF gives no link a mass; otherwise those on a
