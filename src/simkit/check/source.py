@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.check import source_mjcf
+from simkit.check import source_mjcf, source_usd
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.kitio.oneline import one_line
@@ -149,7 +149,9 @@ def check_source(kit: Kit) -> list[Finding]:
     except Exception as exc:
         why = " ".join(str(exc).split())[:200]
         return [*findings, require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
-    return findings + compare_robots(source, built, Allowed.of(kit.doc))
+    allowed = Allowed.of(kit.doc)
+    usd = source_usd.compare(kit, source_usd.source_of_urdf(source), allowed)
+    return findings + compare_robots(source, built, allowed) + usd
 
 
 def _read_leniently(path: Path) -> tuple[object | None, list[str]]:

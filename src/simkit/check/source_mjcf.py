@@ -27,6 +27,7 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
+from simkit.check import source_usd
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.kitio.oneline import one_line
@@ -83,7 +84,7 @@ def compare(kit: Kit, allowed) -> list[Finding]:
     declared = (kit.doc.get("collision_pairs") or {}).get("declared", [])
     excludes = _excludes(pairs, declared)
     out += _findings("source.excludes", excludes, f"{source.nexclude} contact excludes agree")
-    return out
+    return out + source_usd.compare(kit, source_usd.source_of_mjcf(source), allowed)
 
 
 def _lay_out(main: Path, assets: dict, folder: Path) -> list[str]:
