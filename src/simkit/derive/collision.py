@@ -27,7 +27,7 @@ import numpy as np
 
 from simkit.errors import SpecError
 from simkit.model.hull import facet_depth, facet_planes
-from simkit.model.robot import Link, Mesh, Shape
+from simkit.model.robot import Link, Mesh, Shape, canonical_triangles
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
 #: CoACD settings from issue 3's measurements ("Tuned CoACD": 3.8 s a link, 10 pieces).
@@ -140,14 +140,16 @@ def convex_mesh(solid) -> Mesh:
     """The mesh of a hull, exactly convex. manifold3d's hull of near-coplanar points (a piece
     grown by `cover` to take in visual vertices just outside it) can fold faces inward by a
     fraction of a millimetre (a 7-dof arm's upper link in the corpus: 0.4 mm); such a mesh is
-    replaced by qhull's triangulated hull of the same vertices, faces turned outward. A convex
-    mesh is kept as it is (the same bytes as before)."""
+    replaced by qhull's triangulated hull of the same vertices, faces turned outward. Either
+    way the triangles come in one fixed order (`canonical_triangles`): manifold3d lists a
+    hull's triangles in an order that varies between calls, and a cold build elsewhere wrote
+    the same piece's OBJ with other bytes."""
     mesh = _mesh(solid)
     hull = facet_planes(mesh.vertices)
     planes = hull.equations
     samples = np.vstack([mesh.vertices, mesh.vertices[mesh.faces].mean(axis=1)])
     if -facet_depth(samples, hull, -CONVEX_EPS).min() <= CONVEX_EPS:
-        return mesh
+        return Mesh.of(mesh.vertices, canonical_triangles(mesh.faces))
     keep = np.sort(hull.vertices)
     index = np.full(len(mesh.vertices), -1, dtype=np.int64)
     index[keep] = np.arange(len(keep))
@@ -157,7 +159,7 @@ def convex_mesh(solid) -> Mesh:
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     flip = np.einsum("ij,ij->i", normal, planes[:, :3]) < 0
     faces[flip] = faces[flip][:, ::-1]
-    return Mesh.of(vertices, faces)
+    return Mesh.of(vertices, canonical_triangles(faces))
 
 
 # --- exact convex pieces -----------------------------------------------------------------
