@@ -124,19 +124,22 @@ def test_the_tool_chain_comes_first_in_joint_order(tmp_path):
 
 def test_convexity_measure_sees_a_fold_and_convex_mesh_keeps_a_convex_piece():
     """A cube whose top face is folded 1 mm inward is not convex and the check's measure
-    reports exactly the fold; a convex piece passes and `convex_mesh` keeps it as it is."""
+    reports exactly the fold; a convex piece passes and `convex_mesh` keeps its vertices and
+    triangles (in the canonical order)."""
     import manifold3d as mf
 
     from simkit.check.geometry import _dent
     from simkit.derive.collision import convex_mesh
     from simkit.derive.solids import to_mesh
+    from simkit.model.robot import canonical_triangles
 
     cube = mf.Manifold.cube((0.1, 0.1, 0.1))
     vertices, faces = np.array(to_mesh(cube).vertices), np.array(to_mesh(cube).faces)
     assert _dent(vertices, faces) < 1e-12
-    # a sliver-free convex piece is returned as it is
+    # a sliver-free convex piece keeps its vertices and triangles, in the canonical order
     same = convex_mesh(cube)
-    assert np.array_equal(same.vertices, vertices) and np.array_equal(same.faces, faces)
+    assert np.array_equal(same.vertices, vertices)
+    assert np.array_equal(same.faces, canonical_triangles(faces))
     # fold: add a vertex 1 mm below the top face's centre, joined to the top's corners
     top = [i for i, v in enumerate(vertices) if v[2] > 0.05]
     dented = np.vstack([vertices, [0.05, 0.05, 0.099]])

@@ -26,8 +26,10 @@ Progress = Callable[[str], None]
 
 SOLID_STEP, SOLID_VERSION = "link_solid", 1
 #: 4: pieces whose manifold3d hull folds are qhull's exact hull (3292af1 changed that without a
-#: new version, so caches from before kept folded pieces that fail `collision.convex`)
-COLLISION_STEP, COLLISION_VERSION = "collision", 4
+#: new version, so caches from before kept folded pieces that fail `collision.convex`);
+#: 5: every piece's triangles in the canonical order (a cache from before holds manifold3d's
+#: varying order, and a cached build would differ from an uncached one)
+COLLISION_STEP, COLLISION_VERSION = "collision", 5
 HULL_STEP, HULL_VERSION = "given_hull", 1
 
 
