@@ -167,10 +167,12 @@ def test_coacd_cached_warm_runs_none_and_corrupt_entries_are_repaired(tmp_path):
 
 def test_outside_depth_by_cells_is_every_plane_at_once():
     """The grid culling keeps, for each point, the plane that gives its maximum."""
+    from simkit.model import hull as hull_module
+
     rng = np.random.default_rng(3)
     hull = to_mesh(mf.Manifold.hull_points(rng.normal(size=(3000, 3))))
     points = rng.uniform(-3.0, 3.0, size=(60_000, 3))
     n, d = collision._halfspaces(hull)
-    assert len(points) * len(d) > collision.CHUNK  # the cell path, not the small one
+    assert len(points) * len(d) > hull_module.CHUNK  # the cell path, not the small one
     brute = collision.plane_values(points, n, d).max(axis=1)
     assert np.array_equal(collision.outside_depth(points, hull), brute)

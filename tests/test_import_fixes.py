@@ -209,10 +209,11 @@ def test_outside_depth_in_blocks_is_the_same_as_at_once(monkeypatch):
 
     from simkit.derive import collision
     from simkit.derive.solids import to_mesh
+    from simkit.model import hull as hull_module
 
     hull = to_mesh(mf.Manifold.sphere(0.1, 48))
     points = np.random.default_rng(0).uniform(-0.2, 0.2, (1000, 3))
     n, d = collision._halfspaces(hull)
     whole = collision.plane_values(points, n, d).max(axis=1)
-    monkeypatch.setattr(collision, "CHUNK", 7 * len(d))  # 7 points a block
+    monkeypatch.setattr(hull_module, "CHUNK", 7 * len(d))  # 7 points a block
     assert np.array_equal(collision.outside_depth(points, hull), whole)

@@ -20,13 +20,13 @@ per link, link frame, metres.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict
 
 import numpy as np
 
 from simkit.errors import SpecError
-from simkit.model.hull import facet_depth, facet_planes
+from simkit.model.hull import facet_depth, facet_planes, plane_max
+from simkit.model.hull import plane_values as hull_plane_values
 from simkit.model.robot import Link, Mesh, Shape, canonical_triangles
 
 MAX_PIECES = 10  # kit page: "convex pieces per link, up to ten"
@@ -51,8 +51,6 @@ COACD_PARAMS: dict[str, object] = {
 }
 COARSE_TOLERANCE = 0.0005  # m: manifold `simplify` tolerance for the coarse CoACD input
 COARSE_MAX_TRIANGLES = 5000  # issue 3: CoACD input of 2.5k to 5k triangles
-#: grid cells per side for `outside_depth`'s plane culling
-CELLS = 24
 INSIDE_TOL = 1e-7  # m: a point this close to a hull's face counts as inside
 #: Runs of CoACD in this process, plus those reported back by pool workers (tests count them).
 COACD_RUNS = 0
@@ -130,8 +128,6 @@ def _mesh(solid) -> Mesh:
     return to_mesh(solid)
 
 
-#: matrix entries per block in `outside_depth` (8 MB of float64)
-CHUNK = 1 << 20
 #: m: how far a face of a hull may lie inside the exact convex hull of its vertices
 CONVEX_EPS = 1e-7
 
@@ -249,45 +245,16 @@ def _halfspaces(hull: Mesh) -> tuple[np.ndarray, np.ndarray]:
 def outside_depth(points: np.ndarray, hull: Mesh) -> np.ndarray:
     """How far each point lies outside a convex mesh (max face-plane distance; <= 0 inside).
 
-    Exact, cell by cell: the points are binned in a grid of `CELLS` per side, and for a cell
-    of radius r about c a face plane can give a point its maximum only if its distance at c
-    plus r reaches the largest distance at c minus r. A detailed hull (a hobby arm's base,
+    Exact, cell by cell (model/hull.py `plane_max`): a detailed hull (a hobby arm's base,
     9,000 faces, against 100,000 surface samples) drops from every plane for every point (66 s
     on 2 cores) to the few planes facing each cell."""
     n, d = _halfspaces(hull)
-    if not len(points):
-        return np.zeros(0)
-    if len(points) * len(d) <= CHUNK:
-        return _plane_max(points, n, d)
-    lo = points.min(axis=0)
-    size = max(float((points.max(axis=0) - lo).max()) / CELLS, 1e-9)
-    keys = np.floor((points - lo) / size).astype(np.int64)
-    cells, owner = np.unique(keys, axis=0, return_inverse=True)
-    order = np.argsort(owner.ravel(), kind="stable")
-    bounds = np.searchsorted(owner.ravel()[order], np.arange(len(cells) + 1))
-    out = np.empty(len(points))
-    radius = size * math.sqrt(3.0) / 2.0
-    for k, key in enumerate(cells):
-        members = order[bounds[k] : bounds[k + 1]]
-        at_centre = n @ (lo + (key + 0.5) * size) - d
-        keep = at_centre + radius >= at_centre.max() - radius - 1e-12
-        out[members] = _plane_max(points[members], n[keep], d[keep])
-    return out
+    return plane_max(np.asarray(points, dtype=float), np.column_stack([n, -d]))
 
 
 def plane_values(points: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """n . p - d for every point (rows) and plane (columns), term by term: each entry is the
-    same float however the points and planes are split (a matrix product's rounding depends
-    on the kernel BLAS picks for the shape)."""
-    return points[:, :1] * n[:, 0] + points[:, 1:2] * n[:, 1] + points[:, 2:3] * n[:, 2] - d
-
-
-def _plane_max(points: np.ndarray, n: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """max over planes of n . p - d for each point, in blocks of at most `CHUNK` entries."""
-    rows = max(1, CHUNK // max(len(d), 1))
-    return np.concatenate(
-        [plane_values(points[i : i + rows], n, d).max(axis=1) for i in range(0, len(points), rows)]
-    )
+    """n . p - d for every point (rows) and plane (columns), term by term (model/hull.py)."""
+    return hull_plane_values(points, np.column_stack([n, -d]))
 
 
 def cover(hulls: list, samples: np.ndarray) -> list:

@@ -70,19 +70,34 @@ def _nearby_planes(points: np.ndarray, hull) -> np.ndarray:
 CELLS = 16
 
 
+def plane_values(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
+    """n . p + d for every point (rows) and plane (columns; rows n_x, n_y, n_z, d), term by
+    term: each entry is the same float however the points and planes are split (a matrix
+    product's rounding depends on the kernel BLAS picks for the shape)."""
+    n, d = planes[:, :3], planes[:, 3]
+    return points[:, :1] * n[:, 0] + points[:, 1:2] * n[:, 1] + points[:, 2:3] * n[:, 2] + d
+
+
+def _blocks_max(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
+    """max over `planes` of `plane_values`, in blocks of at most `CHUNK` entries."""
+    rows = max(1, CHUNK // max(len(planes), 1))
+    starts = range(0, len(points), rows)
+    return np.concatenate([plane_values(points[i : i + rows], planes).max(axis=1) for i in starts])
+
+
 def plane_max(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
     """Per point, the largest n . p + d over `planes` (rows n_x, n_y, n_z, d; unit normals,
     m): exact, cell by cell. The points are binned in a grid of `CELLS` per side; for a cell
     of radius r about c, a plane can give a point its maximum only if its value at c plus r
     reaches the largest value at c minus r, so each cell is measured against those planes
     only (a 13,000-facet hull against 20,000 visual vertices: a few hundred planes a cell,
-    not all of them)."""
+    not all of them). Each value is `plane_values`', so the result does not depend on how
+    the points fall into cells or blocks."""
     points = np.asarray(points, dtype=float)
     if not len(points):
         return np.zeros(0)
-    normals, offsets = planes[:, :3], planes[:, 3]
     if len(points) * len(planes) <= CHUNK:
-        return (points @ normals.T + offsets).max(axis=1)
+        return _blocks_max(points, planes)
     low = points.min(axis=0)
     size = max(float((points.max(axis=0) - low).max()) / CELLS, 1e-9)
     keys = np.floor((points - low) / size).astype(np.int64)
@@ -93,10 +108,7 @@ def plane_max(points: np.ndarray, planes: np.ndarray) -> np.ndarray:
     radius = size * np.sqrt(3.0) / 2.0
     for k, key in enumerate(cells):
         members = order[bounds[k] : bounds[k + 1]]
-        at_centre = normals @ (low + (key + 0.5) * size) + offsets
+        at_centre = planes[:, :3] @ (low + (key + 0.5) * size) + planes[:, 3]
         keep = at_centre + radius >= at_centre.max() - radius - 1e-12
-        rows = max(1, CHUNK // int(keep.sum()))
-        for i in range(0, len(members), rows):
-            block = members[i : i + rows]
-            out[block] = (points[block] @ normals[keep].T + offsets[keep]).max(axis=1)
+        out[members] = _blocks_max(points[members], planes[keep])
     return out
