@@ -23,8 +23,7 @@ from simkit.check import gpu_broadphase as bp
 def crowding(model, data, groups: dict) -> int:
     """The most pairs of one group whose bounding spheres come within `bp.NEAR` (m)."""
     most = 0
-    for members in groups.values():
-        ids = np.array([(model.pair_geom1[i], model.pair_geom2[i]) for i in members])
+    for _, ids in groups:
         centre = np.linalg.norm(data.geom_xpos[ids[:, 0]] - data.geom_xpos[ids[:, 1]], axis=1)
         most = max(most, int(np.count_nonzero(centre - model.geom_rbound[ids].sum(1) <= bp.NEAR)))
     return most
@@ -34,7 +33,7 @@ def survey(path: Path, samples: int, seed: int) -> dict:
     model = copy.deepcopy(mujoco.MjModel.from_xml_path(str(path)))
     model.pair_margin[:] = bp.NEAR
     data = mujoco.MjData(model)
-    groups = bp._groups(model)
+    groups = bp.pair_groups(model)
     index = {
         frozenset((int(model.pair_geom1[i]), int(model.pair_geom2[i]))): i
         for i in range(model.npair)
@@ -49,7 +48,7 @@ def survey(path: Path, samples: int, seed: int) -> dict:
             continue
         touching = {index.get(frozenset(int(g) for g in p)) for p in contacts.geom} - {None}
         if touching:
-            ranks.append(bp._ranks(model, data, groups, touching))
+            ranks.append(bp.ranks(data, model.geom_rbound, groups, touching))
             crowds.append(crowding(model, data, groups))
     return {
         "file": path.name,

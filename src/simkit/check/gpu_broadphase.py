@@ -35,19 +35,22 @@ def numeric(model, name: str) -> int | None:
     return None if index < 0 else int(model.numeric_data[model.numeric_adr[index]])
 
 
-def _groups(model) -> dict[tuple, list[int]]:
-    """Explicit pair indices by their two geom types, planes and height fields left out (MJX
-    never culls those)."""
+def pair_groups(model) -> list[tuple[list[int], np.ndarray]]:
+    """(explicit pair indices, their geom id pairs) by the pairs' two geom types, planes and
+    height fields left out (MJX never culls those); groups sorted by type."""
     import mujoco
 
     exempt = {int(mujoco.mjtGeom.mjGEOM_PLANE), int(mujoco.mjtGeom.mjGEOM_HFIELD)}
-    out: dict[tuple, list[int]] = {}
+    by_types: dict[tuple, list[int]] = {}
     for i in range(model.npair):
         pair = (model.pair_geom1[i], model.pair_geom2[i])
         types = tuple(sorted(int(model.geom_type[g]) for g in pair))
         if not set(types) & exempt:
-            out.setdefault(types, []).append(i)
-    return out
+            by_types.setdefault(types, []).append(i)
+    return [
+        (members, np.array([(model.pair_geom1[i], model.pair_geom2[i]) for i in members]))
+        for _, members in sorted(by_types.items())
+    ]
 
 
 def configurations(model, samples: int, seed: int) -> np.ndarray:
@@ -73,12 +76,12 @@ def configurations(model, samples: int, seed: int) -> np.ndarray:
     return np.vstack([model.key_qpos, rows]) if model.nkey else rows
 
 
-def _ranks(model, data, groups: dict[tuple, list[int]], touching: set[int]) -> int:
-    """The worst rank by bounding-sphere distance, within its group, of a touching pair."""
+def ranks(data, rbound: np.ndarray, groups: list, touching: set[int]) -> int:
+    """The worst rank by bounding-sphere distance, within its group (`pair_groups`), of a
+    touching pair."""
     worst = 0
-    for members in groups.values():
-        ids = np.array([(model.pair_geom1[i], model.pair_geom2[i]) for i in members])
-        xpos, rbound = data.geom_xpos, model.geom_rbound
+    for members, ids in groups:
+        xpos = data.geom_xpos
         gap = np.linalg.norm(xpos[ids[:, 0]] - xpos[ids[:, 1]], axis=1) - rbound[ids].sum(axis=1)
         for k, i in enumerate(members):
             if i in touching:
@@ -95,10 +98,10 @@ def worst_rank(model, samples: int = SAMPLES, seed: int = SEED) -> int:
     model = copy.deepcopy(model)
     model.pair_margin[:] = NEAR
     data = mujoco.MjData(model)
-    groups = _groups(model)
+    groups = pair_groups(model)
     index = {
         frozenset((int(model.pair_geom1[i]), int(model.pair_geom2[i]))): i
-        for members in groups.values()
+        for members, _ in groups
         for i in members
     }
     worst = 0
@@ -112,7 +115,7 @@ def worst_rank(model, samples: int = SAMPLES, seed: int = SEED) -> int:
         touching = {index.get(frozenset(int(g) for g in pair)) for pair in contacts.geom}
         touching.discard(None)
         if touching:
-            worst = max(worst, _ranks(model, data, groups, touching))  # type: ignore[arg-type]
+            worst = max(worst, ranks(data, model.geom_rbound, groups, touching))  # type: ignore[arg-type]
     return worst
 
 

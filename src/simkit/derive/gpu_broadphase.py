@@ -48,14 +48,23 @@ def _gaps(xpos: np.ndarray, rbound: np.ndarray, ids: np.ndarray) -> np.ndarray:
     return np.linalg.norm(xpos[ids[:, 0]] - xpos[ids[:, 1]], axis=1) - rbound[ids].sum(axis=1)
 
 
-def crowding(xpos: np.ndarray, rbound: np.ndarray, pairs: list[tuple], touching) -> tuple[int, int]:
-    """(the most pairs of one group whose bounding spheres come within `NEAR`, the worst rank
-    of a pair in `touching` within its group); `pairs` are (geom id, geom id, group). A pair
-    in contact has a gap under NEAR, so its rank is at most the first number."""
-    crowd = worst = 0
-    for group in {p[2] for p in pairs}:
+def grouped(pairs: list[tuple]) -> list[tuple[list[int], np.ndarray]]:
+    """(indices into `pairs`, their geom id pairs) of each MJX group, groups sorted; `pairs`
+    are (geom id, geom id, group)."""
+    out = []
+    for group in sorted({p[2] for p in pairs}):
         members = [i for i, p in enumerate(pairs) if p[2] == group]
-        gap = _gaps(xpos, rbound, np.array([pairs[i][:2] for i in members], dtype=int))
+        out.append((members, np.array([pairs[i][:2] for i in members], dtype=int)))
+    return out
+
+
+def crowding(xpos: np.ndarray, rbound: np.ndarray, groups: list, touching) -> tuple[int, int]:
+    """(the most pairs of one group whose bounding spheres come within `NEAR`, the worst rank
+    of a pair in `touching` within its group); `groups` as `grouped` gives them. A pair in
+    contact has a gap under NEAR, so its rank is at most the first number."""
+    crowd = worst = 0
+    for members, ids in groups:
+        gap = _gaps(xpos, rbound, ids)
         crowd = max(crowd, int(np.count_nonzero(gap <= NEAR)))
         for k, i in enumerate(members):
             if i in touching:  # ties count against the pair
@@ -63,9 +72,9 @@ def crowding(xpos: np.ndarray, rbound: np.ndarray, pairs: list[tuple], touching)
     return crowd, worst
 
 
-def _touching(data, ids: list[tuple], depth: float) -> set[int] | None:
-    """Indices of the pairs in contact, or None where one penetrates deeper than `depth`."""
-    index = {frozenset(p[:2]): i for i, p in enumerate(ids)}
+def _touching(data, index: dict, depth: float) -> set[int] | None:
+    """Indices of the pairs in contact (`index`: geom id pair -> pair index), or None where
+    one penetrates deeper than `depth`."""
     out = set()
     for c in range(data.ncon):
         i = index.get(frozenset(int(g) for g in data.contact.geom[c]))
@@ -90,6 +99,8 @@ def max_geom_pairs(
     data = mujoco.MjData(model)
     gid = {model.geom(i).name: i for i in range(model.ngeom)}
     ids = [(gid[a], gid[b], group) for a, b, group in pairs]
+    groups = grouped(ids)
+    index = {frozenset(p[:2]): i for i, p in enumerate(ids)}
     names = [j for j, _, _ in sampled_joints(robot)]
     adr = np.array([model.jnt_qposadr[model.joint(n).id] for n in names], dtype=int)
     crowd = worst = 0
@@ -97,9 +108,9 @@ def max_geom_pairs(
         data.qpos[adr] = row
         mujoco.mj_kinematics(model, data)
         mujoco.mj_collision(model, data)
-        touching = _touching(data, ids, depth)
+        touching = _touching(data, index, depth)
         if touching:
-            seen = crowding(data.geom_xpos, model.geom_rbound, ids, touching)
+            seen = crowding(data.geom_xpos, model.geom_rbound, groups, touching)
             crowd, worst = max(crowd, seen[0]), max(worst, seen[1])
-    largest = max((sum(1 for p in pairs if p[2] == g) for g in {p[2] for p in pairs}), default=0)
+    largest = max((len(members) for members, _ in groups), default=0)
     return (crowd if 0 < crowd < largest else None), worst
