@@ -67,3 +67,20 @@ def test_a_tampered_joint_limit_fails(kit, tmp_path):
     copy = _tampered(kit, tmp_path, r"(float physics:upperLimit = )[0-9.e+-]+", r"\g<1>10")
     failures = [f.line() for f in _source_usd(copy, kit) if not f.ok]
     assert any("limits" in line for line in failures), failures
+
+
+def test_a_placeholder_span_the_kit_makes_continuous_is_a_listed_difference(tmp_path):
+    """Revolute limits of +-1e16 rad (a spinning rotor's placeholder) become a continuous
+    joint, listed in source_differences; the USD has no limits there, and source.usd
+    accepts the listed difference."""
+    from simkit.pipeline import build
+
+    body = (
+        link("base", mass="3"),
+        link("rotor", mass="0.5"),
+        joint("spin", "base", "rotor", limit='lower="-1e16" upper="1e16" effort="5" velocity="50"'),
+    )
+    done = import_robot(write(tmp_path, "prop", *body), tmp_path / "out")
+    kit = build(str(done.spec_path), tmp_path / "kits").kit_dir
+    found = _source_usd(kit)
+    assert found and all(f.ok for f in found), [f.line() for f in found]
