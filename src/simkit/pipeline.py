@@ -59,7 +59,8 @@ class BuildResult:
 
 
 def find_spec(target: str) -> tuple[Path, str]:
-    """A robot name from robots/ or a path to a YAML file -> (path, name shown in outputs)."""
+    """A robot name from robots/ or a path to a YAML file -> (path, name shown in messages).
+    Outputs name the spec by `spec_identity` instead, which is the same however it is given."""
     candidate = Path(target)
     if candidate.suffix in (".yaml", ".yml"):
         if not candidate.is_file():
@@ -70,6 +71,13 @@ def find_spec(target: str) -> tuple[Path, str]:
         known = ", ".join(robot_names())
         raise UnknownRobot(f"unknown robot '{target}' (known: {known}; or give a path to a .yaml)")
     return path, f"robots/{path.name}"
+
+
+def spec_identity(path: Path) -> str:
+    """The spec as every output names it: its file name (`NAME.yaml`). Never its folder, the
+    working directory or how the build named it (a robot name, a relative or absolute path),
+    so every way of naming one spec gives the same bytes (issue 38)."""
+    return path.name
 
 
 def model_from_spec(
@@ -84,7 +92,7 @@ def model_from_spec(
     say = progress or (lambda _msg: None)
     say(f"spec {shown}")
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
-    robot = resolve(spec, doc.text.encode("utf-8"), shown)
+    robot = resolve(spec, doc.text.encode("utf-8"), spec_identity(path))
     say("derive solids, mass properties, servos")
     try:
         return derive_all(robot, path.parent, cache, jobs, progress)

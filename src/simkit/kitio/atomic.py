@@ -273,12 +273,19 @@ def repair(out_dir: Path, robot: str) -> str | None:
     return said
 
 
+def leftovers(out_dir: Path, robot: str) -> list[Path]:
+    """The staging, trash and temporary entries an interrupted build of `robot` left in
+    `out_dir` (`.NAME.<id>.staging`, `.NAME.<id>.trash`, `.NAME.<id>.tmp`): simkit's own names
+    for this kit only, never another kit's or a user's file."""
+    suffixes = (".staging", ".trash", ".tmp")
+    return [p for p in sorted(out_dir.glob(f".{robot}.*")) if p.name.endswith(suffixes)]
+
+
 def clean(out_dir: Path, robot: str) -> None:
     """Remove what an interrupted build of `robot` left (call with the lock held): staging
     and trash folders and, once the kit is a plain folder, an earlier simkit's generations."""
-    for path in sorted(out_dir.glob(f".{robot}.*")):
-        if path.name.endswith((".staging", ".trash", ".tmp")):
-            _remove(path)
+    for path in leftovers(out_dir, robot):
+        _remove(path)
     kit, zip_path, _ = _visible(out_dir, robot)
     if kit.is_symlink() or zip_path.is_symlink():
         return  # still the generation layout: its links point into .NAME.current
