@@ -13,6 +13,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 from simkit.check import run_checks_cached
@@ -21,7 +22,7 @@ from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.emit.ros2 import package_warning
 from simkit.errors import CheckFailed, SimkitError, SpecError, UnknownRobot
-from simkit.kitio import atomic, confine, forked, layout, manifest, noop, reuse
+from simkit.kitio import atomic, confine, forked, layout, manifest, noop, reuse, room
 from simkit.kitio.archive import zip_bytes
 from simkit.kitio.cache import (
     Arrays,
@@ -85,14 +86,19 @@ def model_from_spec(
     progress: Progress | None = None,
     cache: Cache | None = None,
     jobs: int | None = None,
+    before_derive: Callable[[str], None] | None = None,
 ) -> Robot:
     """Load, validate, resolve and derive: the frozen model every emitter reads. `cache`:
-    see `derive.derive_all` (None: the user cache folder); `jobs`: worker processes."""
+    see `derive.derive_all` (None: the user cache folder); `jobs`: worker processes;
+    `before_derive`: called with the robot's name once the spec is valid (the build's
+    fail-fast checks of `--out`)."""
     path, shown = find_spec(target)
     say = progress or (lambda _msg: None)
     say(f"spec {shown}")
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
     robot = resolve(spec, doc.text.encode("utf-8"), spec_identity(path))
+    if before_derive is not None:
+        before_derive(robot.name)
     say("derive solids, mass properties, servos")
     try:
         return derive_all(robot, path.parent, cache, jobs, progress)
@@ -294,7 +300,8 @@ def _build(
 ) -> tuple[BuildResult, list[Path]]:
     """`build` after the warm worker is settled: the result and the files the spec names."""
     say = progress or (lambda _msg: None)
-    robot = model_from_spec(target, progress, cache, jobs)
+    # an --out that cannot take the kit is one line before any derive work (kitio/room.py)
+    robot = model_from_spec(target, progress, cache, jobs, partial(room.preflight, out_dir))
     step = step and robot.step  # the spec can leave the STEP out too
     say("emit")
     files = emit_cached(robot, usd_format, cache, step)

@@ -76,16 +76,20 @@ def step(name: str) -> None:
         os.kill(os.getpid(), signal.SIGTERM)
 
 
-def _writable(out_dir: Path) -> None:
-    """Create `out_dir`; any failure is one line (a file in the way, no permission, ...)."""
+def writable(out_dir: Path) -> None:
+    """Create `out_dir`; any failure is one line naming it and saying what to do (a file in
+    the way, no permission, ...)."""
+    fix = "give --out a folder you can write to"
     if out_dir.exists() and not out_dir.is_dir():
-        raise SimkitError(f"{out_dir}: --out is a file, not a folder")
+        raise SimkitError(f"{out_dir}: --out is a file, not a folder; {fix}")
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise SimkitError(f"{out_dir}: cannot create the output folder: {exc.strerror}") from None
+        raise SimkitError(
+            f"{out_dir}: cannot create the output folder: {exc.strerror}; {fix}"
+        ) from None
     if not os.access(out_dir, os.W_OK | os.X_OK):
-        raise SimkitError(f"{out_dir}: the output folder is not writable")
+        raise SimkitError(f"{out_dir}: the output folder is not writable; {fix}")
 
 
 def acquire(out_dir: Path, shared: bool = False) -> int:
@@ -94,7 +98,7 @@ def acquire(out_dir: Path, shared: bool = False) -> int:
     import fcntl
 
     if not shared:
-        _writable(out_dir)
+        writable(out_dir)
     fd = os.open(out_dir, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
