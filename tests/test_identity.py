@@ -37,9 +37,7 @@ def _build(target: str, out: Path, cwd: Path) -> str:
 def _files(out: Path) -> dict[str, bytes]:
     """Every file under `out` (kit folder, zip, manifest) by relative path."""
     return {
-        p.relative_to(out).as_posix(): p.read_bytes()
-        for p in sorted(out.rglob("*"))
-        if p.is_file()
+        p.relative_to(out).as_posix(): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()
     }
 
 

@@ -22,10 +22,8 @@ pytestmark = pytest.mark.slow  # builds a real kit, twice
 
 def _cmd(out: Path, cache: Path, *extra: str) -> list[str]:
     spec = out.parent / SPEC.name
-    return [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out), *extra] + [
-        "--cache-dir",
-        str(cache),
-    ]
+    cli = [sys.executable, "-m", "simkit.cli", "build", str(spec), "--out", str(out)]
+    return [*cli, *extra, "--cache-dir", str(cache)]
 
 
 def _kill_while_staging(cmd: list[str], out: Path, env: dict) -> list[str]:
