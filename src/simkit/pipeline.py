@@ -11,7 +11,7 @@ the no-op rebuild (kitio/noop.py), which the CLI tries before importing this mod
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -196,15 +196,17 @@ def emit_cached(robot: Robot, usd_format: str, cache: Cache, step: bool = True) 
 
 
 def simulate_cached(
-    kit_dir: Path, robot: Robot, cache: Cache, step: bool = True
+    kit_dir: Path, robot: Robot, cache: Cache, step: bool = True, kit_files: Iterable[str] = ()
 ) -> dict[str, bytes]:
     """The simulate stage on the staged kit, then the report emitters. The staged files are
-    a pure function of the model, so the model's digest (and the templates) keys both."""
+    a pure function of the model and the options, so the model's digest, the templates and
+    the staged paths (`kit_files`, whose formats robot.json lists) key both."""
+    names = sorted(kit_files)
     return cached_stage(
         cache,
         "simulate",
-        [digest(robot).encode(), *_template_bytes()],
-        lambda: emit_reports(robot, simulate_all(kit_dir, robot), step=step),
+        [digest(robot).encode(), *_template_bytes(), "\n".join(names).encode()],
+        lambda: emit_reports(robot, simulate_all(kit_dir, robot), step=step, kit_files=names),
         _pack_files,
         _unpack_files,
         (*EMIT_LIBRARIES, *SIMULATE_LIBRARIES),
@@ -374,7 +376,7 @@ def _stage_and_publish(
     atomic.stage_kit(staging, out_dir, robot.name, files)
     say("simulate")
     try:
-        reports = simulate_cached(staged_kit, robot, cache, step)
+        reports = simulate_cached(staged_kit, robot, cache, step, files)
     except SpecError as exc:  # e.g. freefall.pose: a release that leaves the limits
         raise _located(target, exc) from None
     clash = sorted(set(files) & set(reports))
