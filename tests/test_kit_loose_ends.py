@@ -71,7 +71,7 @@ def test_the_launch_file_rewrites_every_mesh_itself(seed_kits, name):
     urdf = (
         files[consts["URDF"]].decode().replace(consts["RELATIVE_MESHES"], consts["PACKAGE_MESHES"])
     )
-    meshes = re.findall(r'filename="([^"]+)"', urdf)
+    meshes = re.findall(r'<mesh filename="([^"]+)"', urdf)
     prefix = f"package://{consts['PACKAGE']}/"
     assert meshes and all(m.startswith(prefix) for m in meshes), meshes[:3]
     assert all(m[len(prefix) :] in files for m in meshes)
