@@ -11,8 +11,9 @@ the no-op rebuild (kitio/noop.py), which the CLI tries before importing this mod
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 from simkit.check import run_checks_cached
@@ -21,7 +22,7 @@ from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.emit.ros2 import package_warning
 from simkit.errors import CheckFailed, SimkitError, SpecError, UnknownRobot
-from simkit.kitio import atomic, confine, forked, layout, manifest, noop, reuse
+from simkit.kitio import atomic, confine, forked, layout, manifest, noop, reuse, room
 from simkit.kitio.archive import zip_bytes
 from simkit.kitio.cache import (
     Arrays,
@@ -59,7 +60,8 @@ class BuildResult:
 
 
 def find_spec(target: str) -> tuple[Path, str]:
-    """A robot name from robots/ or a path to a YAML file -> (path, name shown in outputs)."""
+    """A robot name from robots/ or a path to a YAML file -> (path, name shown in messages).
+    Outputs name the spec by `spec_identity` instead, which is the same however it is given."""
     candidate = Path(target)
     if candidate.suffix in (".yaml", ".yml"):
         if not candidate.is_file():
@@ -72,19 +74,31 @@ def find_spec(target: str) -> tuple[Path, str]:
     return path, f"robots/{path.name}"
 
 
+def spec_identity(path: Path) -> str:
+    """The spec as every output names it: its file name (`NAME.yaml`). Never its folder, the
+    working directory or how the build named it (a robot name, a relative or absolute path),
+    so every way of naming one spec gives the same bytes (issue 38)."""
+    return path.name
+
+
 def model_from_spec(
     target: str,
     progress: Progress | None = None,
     cache: Cache | None = None,
     jobs: int | None = None,
+    before_derive: Callable[[str], None] | None = None,
 ) -> Robot:
     """Load, validate, resolve and derive: the frozen model every emitter reads. `cache`:
-    see `derive.derive_all` (None: the user cache folder); `jobs`: worker processes."""
+    see `derive.derive_all` (None: the user cache folder); `jobs`: worker processes;
+    `before_derive`: called with the robot's name once the spec is valid (the build's
+    fail-fast checks of `--out`)."""
     path, shown = find_spec(target)
     say = progress or (lambda _msg: None)
     say(f"spec {shown}")
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
-    robot = resolve(spec, doc.text.encode("utf-8"), shown)
+    robot = resolve(spec, doc.text.encode("utf-8"), spec_identity(path))
+    if before_derive is not None:
+        before_derive(robot.name)
     say("derive solids, mass properties, servos")
     try:
         return derive_all(robot, path.parent, cache, jobs, progress)
@@ -182,15 +196,17 @@ def emit_cached(robot: Robot, usd_format: str, cache: Cache, step: bool = True) 
 
 
 def simulate_cached(
-    kit_dir: Path, robot: Robot, cache: Cache, step: bool = True
+    kit_dir: Path, robot: Robot, cache: Cache, step: bool = True, kit_files: Iterable[str] = ()
 ) -> dict[str, bytes]:
     """The simulate stage on the staged kit, then the report emitters. The staged files are
-    a pure function of the model, so the model's digest (and the templates) keys both."""
+    a pure function of the model and the options, so the model's digest, the templates and
+    the staged paths (`kit_files`, whose formats robot.json lists) key both."""
+    names = sorted(kit_files)
     return cached_stage(
         cache,
         "simulate",
-        [digest(robot).encode(), *_template_bytes()],
-        lambda: emit_reports(robot, simulate_all(kit_dir, robot), step=step),
+        [digest(robot).encode(), *_template_bytes(), "\n".join(names).encode()],
+        lambda: emit_reports(robot, simulate_all(kit_dir, robot), step=step, kit_files=names),
         _pack_files,
         _unpack_files,
         (*EMIT_LIBRARIES, *SIMULATE_LIBRARIES),
@@ -286,7 +302,8 @@ def _build(
 ) -> tuple[BuildResult, list[Path]]:
     """`build` after the warm worker is settled: the result and the files the spec names."""
     say = progress or (lambda _msg: None)
-    robot = model_from_spec(target, progress, cache, jobs)
+    # an --out that cannot take the kit is one line before any derive work (kitio/room.py)
+    robot = model_from_spec(target, progress, cache, jobs, partial(room.preflight, out_dir))
     step = step and robot.step  # the spec can leave the STEP out too
     say("emit")
     files = emit_cached(robot, usd_format, cache, step)
@@ -359,7 +376,7 @@ def _stage_and_publish(
     atomic.stage_kit(staging, out_dir, robot.name, files)
     say("simulate")
     try:
-        reports = simulate_cached(staged_kit, robot, cache, step)
+        reports = simulate_cached(staged_kit, robot, cache, step, files)
     except SpecError as exc:  # e.g. freefall.pose: a release that leaves the limits
         raise _located(target, exc) from None
     clash = sorted(set(files) & set(reports))

@@ -1,4 +1,4 @@
-"""`simkit import`: a URDF or xacro becomes a spec YAML plus its meshes (simkit/importer)."""
+"""`simkit import`: a URDF, xacro or MJCF becomes a spec YAML plus its meshes (simkit/importer)."""
 
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ from simkit.errors import SimkitError
     "--hull",
     "hull_collision",
     is_flag=True,
-    help="Collision meshes: the visual's convex hull (one piece) instead of the URDF's.",
+    help="Collision meshes: the visual's convex hull (one piece) instead of the source's.",
 )
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False, path_type=Path))
 @click.option("-q", "--quiet", is_flag=True, help="Print only errors and the result.")
@@ -72,7 +72,8 @@ def import_urdf(
     allow_read: tuple[Path, ...],
     trust_xacro: bool,
 ) -> None:
-    """Turn a URDF or xacro into OUT/NAME.yaml plus the meshes it needs."""
+    """Turn a URDF, a xacro or an MJCF (MuJoCo's XML, a <mujoco> file) at PATH into
+    OUT/NAME.yaml plus the meshes it needs."""
     from simkit.importer import import_robot
     from simkit.importer.read.options import ReadOptions, parse_xacro_arg
 

@@ -5,7 +5,7 @@ Emitters do no I/O, read no clock and draw no random numbers.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import partial
 
 from simkit.emit import (
@@ -63,12 +63,15 @@ def emit_all(robot: Robot, emitters: dict[str, Emitter] | None = None) -> dict[s
     return _collect(run_all(jobs, BACKGROUND))
 
 
-def emit_reports(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, bytes]:
+def emit_reports(
+    robot: Robot, reports: SimReports, step: bool = True, kit_files: Iterable[str] = ()
+) -> dict[str, bytes]:
     """The report emitters, robot.json and the free-fall files, after the simulate stage, on
-    its reports; `step`: whether the kit has a STEP assembly (robot.json `geometry.step`)."""
+    its reports; `step`: whether the kit has a STEP assembly (robot.json `geometry.step`);
+    `kit_files`: the model emitters' paths (robot.json `files` lists their formats)."""
     return _collect(
         {
-            "robot_json": robot_json.emit(robot, reports, step=step),
+            "robot_json": robot_json.emit(robot, reports, step=step, kit_files=kit_files),
             "freefall_files": freefall_files.emit(robot, reports),
         }
     )

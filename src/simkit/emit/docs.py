@@ -174,7 +174,8 @@ MUJOCO_PAGE_NAMES = {
     "sensors": ("imu_ang_vel", "imu_lin_vel", "imu_quat"),
 }
 MUJOCO_PAGE = {
-    "source": "001_71a395c46b8a5939.txt",
+    # the document's title, as the spec's `sources` names it (the kit ships no copy of it)
+    "source": "the Asimov MuJoCo model (asimov.xml) reference",
     "page_path": "sim-model/xmls/asimov.xml",
     "knee_geom": "left_knee_link_collision",
 }

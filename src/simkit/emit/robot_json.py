@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 from simkit import __version__
 from simkit.derive.solids import CIRCULAR_SEGMENTS, SPHERE_SEGMENTS
@@ -131,12 +132,7 @@ def document(robot: Robot, reports: SimReports) -> dict:
         "title": robot.title,
         "description": robot.description,
         "units": {"length": "m", "mass": "kg", "angle": "rad", "time": "s", "torque": "N m"},
-        "files": {
-            "urdf": layout.urdf(robot.name),
-            "mjcf": layout.mjcf(robot.name),
-            "mjcf_mjx": layout.mjcf_mjx(robot.name),
-            "glb": layout.glb(robot.name),
-        },
+        "files": document_files(robot),
         "base_frame": products.base_frame or robot.root,
         "tool_frame": robot.tool_frame,
         "wrist_centre": robot.wrist_centre,
@@ -297,8 +293,6 @@ def _generalise(robot: Robot, doc: dict) -> None:
             "MuJoCo qpos starts with its position (m) and quaternion (w, x, y, z)",
         }
         doc["frames"][robot.root]["role"] = "the world; the floating base moves freely in it"
-    if not mjcf_world.servos_in_main(robot):
-        doc["files"]["mjcf_scene"] = layout.mjcf_scene(robot.name)
     if robot.mjcf is not None and robot.mjcf.sensors:
         doc["sensors"] = [s.model_dump(exclude_none=True) for s in robot.mjcf.sensors]
 
@@ -331,10 +325,51 @@ def step_geometry(robot: Robot) -> dict:
     return out
 
 
-def emit(robot: Robot, reports: SimReports, step: bool = True) -> dict[str, bytes]:
+def _more_formats(robot: str) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """`files` keys beyond the MuJoCo, URDF and GLB entries, each with the paths that can
+    stand for it (the first the kit holds is listed)."""
+    return (
+        ("sdf", (layout.sdf(robot),)),
+        ("srdf", (layout.srdf(robot),)),
+        ("usd", (layout.usd(robot), layout.usd(robot, binary=True))),
+        ("usd_asset", (layout.usd_asset(robot), layout.usd_asset(robot, binary=True))),
+        ("step", (layout.step(robot),)),
+    )
+
+
+def files_block(robot: Robot, kit_files: Iterable[str]) -> dict[str, str]:
+    """robot.json `files`: the entry file of every format the kit holds, so a reader finds
+    each one without knowing the layout (issue 38)."""
+    have = set(kit_files)
+    files = dict(document_files(robot))
+    for key, candidates in _more_formats(robot.name):
+        found = next((path for path in candidates if path in have), None)
+        if found is not None:
+            files[key] = found
+    return files
+
+
+def document_files(robot: Robot) -> dict[str, str]:
+    """The `files` entries every kit has (the MJCF scene where the servos are apart)."""
+    files = {
+        "urdf": layout.urdf(robot.name),
+        "mjcf": layout.mjcf(robot.name),
+        "mjcf_mjx": layout.mjcf_mjx(robot.name),
+        "glb": layout.glb(robot.name),
+    }
+    if not mjcf_world.servos_in_main(robot):
+        files["mjcf_scene"] = layout.mjcf_scene(robot.name)
+    return files
+
+
+def emit(
+    robot: Robot, reports: SimReports, step: bool = True, kit_files: Iterable[str] = ()
+) -> dict[str, bytes]:
     """`robot.json` (a report emitter: it runs after the simulate stage); `step`: the kit has
-    a STEP assembly (`geometry.step`, else null)."""
+    a STEP assembly (`geometry.step`, else null); `kit_files`: the model emitters' paths,
+    whose formats `files` lists."""
     doc = document(robot, reports)
+    doc["files"] = files_block(robot, kit_files)
     doc["geometry"]["step"] = step_geometry(robot) if step else None
     if robot.source is not None:  # an imported robot; a hand-written spec adds nothing
         doc["source"] = {"file": robot.source[0], "sha256": robot.source[1]}

@@ -76,16 +76,20 @@ def step(name: str) -> None:
         os.kill(os.getpid(), signal.SIGTERM)
 
 
-def _writable(out_dir: Path) -> None:
-    """Create `out_dir`; any failure is one line (a file in the way, no permission, ...)."""
+def writable(out_dir: Path) -> None:
+    """Create `out_dir`; any failure is one line naming it and saying what to do (a file in
+    the way, no permission, ...)."""
+    fix = "give --out a folder you can write to"
     if out_dir.exists() and not out_dir.is_dir():
-        raise SimkitError(f"{out_dir}: --out is a file, not a folder")
+        raise SimkitError(f"{out_dir}: --out is a file, not a folder; {fix}")
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise SimkitError(f"{out_dir}: cannot create the output folder: {exc.strerror}") from None
+        raise SimkitError(
+            f"{out_dir}: cannot create the output folder: {exc.strerror}; {fix}"
+        ) from None
     if not os.access(out_dir, os.W_OK | os.X_OK):
-        raise SimkitError(f"{out_dir}: the output folder is not writable")
+        raise SimkitError(f"{out_dir}: the output folder is not writable; {fix}")
 
 
 def acquire(out_dir: Path, shared: bool = False) -> int:
@@ -94,7 +98,7 @@ def acquire(out_dir: Path, shared: bool = False) -> int:
     import fcntl
 
     if not shared:
-        _writable(out_dir)
+        writable(out_dir)
     fd = os.open(out_dir, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_SH if shared else fcntl.LOCK_EX)
@@ -273,12 +277,19 @@ def repair(out_dir: Path, robot: str) -> str | None:
     return said
 
 
+def leftovers(out_dir: Path, robot: str) -> list[Path]:
+    """The staging, trash and temporary entries an interrupted build of `robot` left in
+    `out_dir` (`.NAME.<id>.staging`, `.NAME.<id>.trash`, `.NAME.<id>.tmp`): simkit's own names
+    for this kit only, never another kit's or a user's file."""
+    suffixes = (".staging", ".trash", ".tmp")
+    return [p for p in sorted(out_dir.glob(f".{robot}.*")) if p.name.endswith(suffixes)]
+
+
 def clean(out_dir: Path, robot: str) -> None:
     """Remove what an interrupted build of `robot` left (call with the lock held): staging
     and trash folders and, once the kit is a plain folder, an earlier simkit's generations."""
-    for path in sorted(out_dir.glob(f".{robot}.*")):
-        if path.name.endswith((".staging", ".trash", ".tmp")):
-            _remove(path)
+    for path in leftovers(out_dir, robot):
+        _remove(path)
     kit, zip_path, _ = _visible(out_dir, robot)
     if kit.is_symlink() or zip_path.is_symlink():
         return  # still the generation layout: its links point into .NAME.current

@@ -2,7 +2,8 @@
 into the same `--out` writes nothing and says so in one line, before any heavy import.
 
 After each build the pipeline records (`remember`) in the cache folder, under a key of
-everything that decides the output: the spec's bytes and path, simkit's code and templates,
+everything that decides the output: the spec's bytes and resolved path (not how the build
+named it: a robot name, a relative or absolute path are one key), simkit's code and templates,
 the installed distributions (every `*.dist-info` on `sys.path`) and Python, the output folder
 and the options that change output or checking (`--usd-format`, `--no-step`, `--no-check`).
 The record lists the files the spec names (meshes), and every published file (kit, zip,
@@ -10,7 +11,9 @@ manifest) with its size, SHA-256 and `stat` identity. A rebuild with the same ke
 when every named file and every published file still matches: a file whose size, mtime,
 ctime and inode are unchanged is trusted (as git's index does), any other is hashed. Any
 difference, a missing record or `--no-cache` runs the full build. The check holds a shared
-`flock` of `--out`, so it waits for a build into it to finish. Standard library only.
+`flock` of `--out`, so it waits for a build into it to finish. A no-op, like every build, removes
+what an interrupted build of the kit left in `--out` (`atomic.leftovers`: `.NAME.<id>.staging`
+after a kill -9, ...), taking the lock exclusively for that. Standard library only.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ import sys
 from pathlib import Path
 
 from simkit import __version__
+from simkit.errors import SimkitError
 from simkit.kitio import atomic, layout, manifest, reuse
 from simkit.kitio.resources import data_dir
 
@@ -107,7 +111,6 @@ def key(target: str, out_dir: Path, options: dict[str, object]) -> str | None:
         return None
     head = {
         "format": FORMAT,
-        "target": target,
         "spec": str(spec.resolve()),
         "out": str(Path(out_dir).resolve()),
         "options": options,
@@ -205,12 +208,21 @@ def unchanged(
         return None
     if doc.get("format") != FORMAT:
         return None
-    try:
-        fd = atomic.acquire(out_dir, shared=True)  # a build into out_dir finishes first
-    except OSError:
+    stale = atomic.leftovers(out_dir, robot)
+    try:  # a build into out_dir finishes first; exclusive when there is something to remove
+        fd = atomic.acquire(out_dir, shared=not stale)
+    except (OSError, SimkitError):
         return None
     try:
-        return _verify(out_dir, robot, checks, named, published, entries)
+        line = _verify(out_dir, robot, checks, named, published, entries)
+        if line is None or not stale:
+            return line
+        stale = atomic.leftovers(out_dir, robot)  # no build runs now: all of them are stale
+        atomic.clean(out_dir, robot)
+        if not stale:
+            return line
+        names = ", ".join(p.name for p in stale)
+        return f"{line}; removed what an interrupted build left: {names}"
     finally:
         atomic.release(fd)
 

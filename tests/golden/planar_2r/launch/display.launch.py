@@ -16,8 +16,9 @@ from launch_ros.actions import Node
 PACKAGE = "planar_2r_description"
 URDF = "urdf/planar_2r.urdf"
 RVIZ = "rviz/planar_2r.rviz"
-# The URDF's mesh paths are relative to the file, which ROS 2 does not resolve: rewrite them
-# to package:// URIs on load (the same as the kit page's sed command).
+# The URDF's mesh paths are relative to the file, which ROS 2 does not resolve: this file
+# rewrites them to package:// URIs as it loads the URDF (robot_description below), so it needs
+# nothing outside the package.
 RELATIVE_MESHES = 'filename="../meshes/'
 PACKAGE_MESHES = 'filename="package://' + PACKAGE + '/meshes/'
 
