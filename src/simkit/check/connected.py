@@ -16,8 +16,10 @@ fraction of a facet).
 rosie_1400) with `python scripts/measure_connected.py build/*_description` (after `simkit
 build` of each; exact gaps): the solids at a joint overlap or keep a running clearance between
 a drive and its output, at most 5 mm (asimov's toe, 5.0 mm; the Rosies' J4, 4 mm; ecn_2r 0).
-The tolerance is twice that, 10 mm. The 150 mm longer upper arm of rosie_600 leaves a gap of
-several centimetres (docs/maintaining.md).
+The small hand-written specs of the test suite keep wider ones by design: 10 mm under
+planar_2r's first link, 20 mm at collision_mix's hub. The tolerance, 25 mm, clears all of
+these; the 150 mm longer upper arm of rosie_600 (J3 moved, its solids not) leaves 39 mm, and
+a link left behind by a longer move leaves more (docs/maintaining.md).
 
 For an imported spec (robot.json carries `source`), whose meshes may float by design (a
 cosmetic shell, a sensor on a bracket that is not modelled), the check reports the gaps and
@@ -34,9 +36,9 @@ from simkit.kitio.fmt import num
 from simkit.kitio.stl import StlMesh, from_stl
 from simkit.model.kinematics import axis_angle, rpy_matrix, transform
 
-#: m: the largest gap at home between a link's solid and its parent's: twice the largest
-#: measured on the five seed robots (5 mm; see the module docstring)
-CONNECTED_TOL = 0.01
+#: m: the largest gap at home between a link's solid and its parent's (measured: at most 5 mm
+#: on the seed robots, 20 mm on the test suite's specs; see the module docstring)
+CONNECTED_TOL = 0.025
 #: points sampled per solid per side (vertices, face centroids, edge midpoints, evenly thinned)
 MAX_POINTS = 4000
 
@@ -88,7 +90,8 @@ def point_gap(a: StlMesh, b: StlMesh) -> float:
 
 
 def solid_gap(a: StlMesh, b: StlMesh) -> float:
-    """The gap (m) between two solids (vertices and faces) in one frame: 0 when they touch or overlap."""
+    """The gap (m) between two solids (vertices, faces) in one frame: 0 when they touch or
+    overlap."""
     import trimesh
     from trimesh.proximity import signed_distance
 
@@ -145,7 +148,8 @@ def check_connected(kit: Kit) -> list[Finding]:
         worst = max(gaps, key=lambda g: g[3], default=None)
         detail = f"{len(gaps)} joints: each link's solid meets its parent's at home"
         if worst is not None:
-            detail += f" (largest gap at most {_m(worst[3])} m, {worst[1]}-{worst[2]} at {worst[0]})"
+            joint, parent, child, gap = worst
+            detail += f" (largest gap at most {_m(gap)} m, {parent}-{child} at {joint})"
         if imported and apart:
             names = ", ".join(f"{c} from {p} ({_m(g)} m)" for _, p, c, g in apart[:5])
             more = f" and {len(apart) - 5} more" if len(apart) > 5 else ""
