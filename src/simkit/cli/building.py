@@ -93,6 +93,8 @@ def build(
 
         cache_ = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
         for target in targets:
+            if not quiet:
+                err.print(f"[{target}] --accept-published: an unchecked build first", markup=False)
             try:
                 lines = accept(target, usd_format, not no_step, cache_)
             except SimkitError as exc:
