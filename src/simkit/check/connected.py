@@ -6,18 +6,19 @@ the FK checks cannot see it, since they follow the joints, not the shapes. This 
 the written files only: robot.json's joints and home pose, and each link's visual STL
 (`meshes/visual/LINK.stl`, link frame, metres).
 
-The gap between two solids is measured from each side: points of one solid (its vertices,
-face centroids and edge midpoints, at most `MAX_POINTS`) against the other's surface by
-trimesh's signed distance; a point inside (or on) the other solid makes the gap 0, else the
-gap is the smaller of the two nearest distances (an upper bound on the true gap, tight to a
-fraction of a facet).
+Each solid is sampled at its vertices, face centroids and edge midpoints (at most
+`MAX_POINTS`). A quick upper bound on the gap comes first: the nearest pair of samples, one
+from each solid (a k-d tree). Only a pair that this cannot clear is measured closely: the
+samples of each solid against the other's surface by trimesh's signed distance; a sample
+inside (or on) the other solid makes the gap 0, else the gap is the smaller of the two
+nearest distances (still an upper bound, tight to a fraction of a facet).
 
 `CONNECTED_TOL` was measured on the five seed robots (asimov, ecn_2r, rosie_600, rosie_1000,
 rosie_1400) with `python scripts/measure_connected.py build/*_description` (after `simkit
 build` of each; exact gaps): the solids at a joint overlap or keep a running clearance between
 a drive and its output, at most 5 mm (asimov's toe, 5.0 mm; the Rosies' J4, 4 mm; ecn_2r 0).
 The small hand-written specs of the test suite keep wider ones by design: 10 mm under
-planar_2r's first link, 20 mm at collision_mix's hub. The tolerance, 25 mm, clears all of
+planar_2r's first link, 20 mm at collision_mix's hub and under test_drake_hull's arm. The tolerance, 25 mm, clears all of
 these; the 150 mm longer upper arm of rosie_600 (J3 moved, its solids not) leaves 39 mm, and
 a link left behind by a longer move leaves more (docs/maintaining.md).
 
