@@ -18,9 +18,10 @@ rosie_1400) with `python scripts/measure_connected.py build/*_description` (afte
 build` of each; exact gaps): the solids at a joint overlap or keep a running clearance between
 a drive and its output, at most 5 mm (asimov's toe, 5.0 mm; the Rosies' J4, 4 mm; ecn_2r 0).
 The small hand-written specs of the test suite keep wider ones by design: 10 mm under
-planar_2r's first link, 20 mm at collision_mix's hub and under test_drake_hull's arm. The tolerance, 25 mm, clears all of
-these; the 150 mm longer upper arm of rosie_600 (J3 moved, its solids not) leaves 39 mm, and
-a link left behind by a longer move leaves more (docs/maintaining.md).
+planar_2r's first link, 20 mm at collision_mix's hub and under test_drake_hull's arm. The
+tolerance, 25 mm, clears all of these; the 150 mm longer upper arm of rosie_600 (J3 moved,
+its solids not) leaves 39 mm, and a link left behind by a longer move leaves more
+(docs/maintaining.md).
 
 For an imported spec (robot.json carries `source`), whose meshes may float by design (a
 cosmetic shell, a sensor on a bracket that is not modelled), the check reports the gaps and
