@@ -50,6 +50,8 @@ def rounding_bound(kit: Kit, q) -> tuple[float, float]:
 
 
 def check_published(kit: Kit) -> list[Finding]:
+    """robot.json's FK reference poses against its own joints, and each published figure
+    against the model (`published_values`)."""
     doc = kit.doc
     findings: list[Finding] = []
     for ref in doc.get("fk_reference", []):
@@ -108,67 +110,31 @@ def published_values(kit: Kit) -> list[Published]:
     `simkit build --accept-published`."""
     doc, pub = kit.doc, kit.doc.get("published", {})
     out: list[Published] = []
+
+    def add(field: str, suffix: str, what: str, model: Any, tolerance: float, unit: str):
+        check = f"published.{field}{suffix}"
+        out.append(Published(field, check, what, pub[field], model, tolerance, unit))
+
     if "mass" in pub:
         total = sum(link["mass"] for link in doc["links"])
-        out.append(
-            Published(
-                "mass", "published.mass", "sum of link masses", pub["mass"], total, MASS_TOL, "kg"
-            )
-        )
+        add("mass", "", "sum of link masses", total, MASS_TOL, "kg")
     if "tool0_home" in pub and doc.get("home") is not None:
         tool = [float(v) for v in kit.fk(doc["home"])[:3, 3]]
-        what = "tool0 at home in base_link"
-        out.append(
-            Published(
-                "tool0_home", "published.tool0_home", what, pub["tool0_home"], tool, LENGTH_TOL, "m"
-            )
-        )
+        add("tool0_home", "", "tool0 at home in base_link", tool, LENGTH_TOL, "m")
     if "base_link_height" in pub:
         height = doc["frames"].get(doc["base_frame"], {}).get("height")
         what = f"{doc['base_frame']} above the root"
-        model = height if height is not None else np.nan
-        out.append(
-            Published(
-                "base_link_height",
-                "published.base_link_height",
-                what,
-                pub["base_link_height"],
-                model,
-                LENGTH_TOL,
-                "m",
-            )
-        )
-    geometric = (doc.get("reach") or {}).get("geometric") or {}
+        add("base_link_height", "", what, np.nan if height is None else height, LENGTH_TOL, "m")
     if "wrist_centre_reach" in pub:
+        geometric = (doc.get("reach") or {}).get("geometric") or {}
         what = "wrist centre from the J1 axis, stretched"
-        model = geometric.get("wrist", np.nan)
-        out.append(
-            Published(
-                "wrist_centre_reach",
-                "published.wrist_centre_reach",
-                what,
-                pub["wrist_centre_reach"],
-                model,
-                LENGTH_TOL,
-                "m",
-            )
-        )
+        add("wrist_centre_reach", "", what, geometric.get("wrist", np.nan), LENGTH_TOL, "m")
         stretched = doc["poses"].get("stretched")
         if stretched is not None and doc.get("wrist_centre"):
             centre = kit.fk(stretched, doc["wrist_centre"])[:3, 3]
             what = "wrist centre from robot.json FK, stretched"
-            model = float(np.hypot(centre[0], centre[1]))
-            out.append(
-                Published(
-                    "wrist_centre_reach",
-                    "published.wrist_centre_reach.fk",
-                    what,
-                    pub["wrist_centre_reach"],
-                    model,
-                    LENGTH_TOL,
-                    "m",
-                )
-            )
+            reach = float(np.hypot(centre[0], centre[1]))
+            add("wrist_centre_reach", ".fk", what, reach, LENGTH_TOL, "m")
     return out
 
 
