@@ -132,7 +132,9 @@ def _one_line(stderr: str) -> bool:
         for line in stderr.splitlines()
         if line.strip() and not line.startswith(("[", "simkit: warning:"))
     ]
-    return len(lines) == 1 and lines[0].startswith("simkit: error: ")
+    # one error, its further lines (a spec's other problems, each failed check) indented or
+    # FILE:LINE: field: message, never a traceback
+    return bool(lines) and lines[0].startswith("simkit: error: ") and "Traceback" not in stderr
 
 
 #: "Over 60 s" means 60 s of CPU in any one process of the build (RLIMIT_CPU): on a shared
@@ -161,7 +163,8 @@ def run_one(
     try:
         load_spec(spec)
     except SpecError as exc:
-        ok = "\n" not in str(exc) and str(exc).startswith(str(spec))
+        lines = [line for line in str(exc).splitlines() if not line.startswith("(and ")]
+        ok = all(line.startswith(str(spec)) for line in lines)  # one line per problem
         return "refused" if ok else "bad_refusal"
     except Exception:  # the fuzzer counts every other exception
         stats.setdefault("examples", []).append(traceback.format_exc(limit=3)[-600:])

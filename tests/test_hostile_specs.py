@@ -37,7 +37,7 @@ def _refused(tmp_path: Path, text: str, field: str, message: str) -> SpecError:
     with pytest.raises(SpecError) as info:
         load_spec(_spec(tmp_path, text))
     err = info.value
-    assert ONE_LINE.match(str(err)), str(err)
+    assert all(ONE_LINE.match(line) for line in str(err).splitlines()), str(err)
     assert err.line is not None and err.field == field and message in err.message, str(err)
     return err
 
@@ -197,7 +197,8 @@ def _one_line_failure(proc: subprocess.CompletedProcess) -> str:
     assert "Traceback" not in proc.stderr + proc.stdout, proc.stderr
     lines = [line for line in proc.stderr.splitlines() if not line.startswith("[")]
     lines = [line for line in lines if not line.startswith("simkit: warning:")]
-    assert len(lines) == 1 and lines[0].startswith("simkit: error: "), proc.stderr
+    assert lines and lines[0].startswith("simkit: error: "), proc.stderr
+    assert all(ONE_LINE.match(line) for line in lines[1:]), proc.stderr  # one per problem
     return lines[0]
 
 

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
-from simkit.check import run_checks_cached
-from simkit.check.findings import Finding
+from simkit.check import published_numbers, run_checks_cached
+from simkit.check.findings import Finding, failure_message
 from simkit.derive import derive_all
 from simkit.emit import EMITTERS, emit_all, emit_reports, usd
 from simkit.emit.ros2 import package_warning
@@ -39,6 +39,7 @@ from simkit.model.resolve import resolve
 from simkit.model.robot import Robot
 from simkit.simulate import simulate_all
 from simkit.spec import locate as spec_locate
+from simkit.spec.load import load_yaml
 from simkit.spec.validate import load_spec
 
 Progress = Callable[[str], None]
@@ -123,6 +124,13 @@ def _located(target: str, exc: SpecError) -> SpecError:
     path, shown = find_spec(target)
     spec, doc = load_spec(path, display=str(path) if not shown.startswith("robots/") else shown)
     return spec_locate.locate(exc, doc, spec, path.parent)
+
+
+def _explainer(target: str) -> Callable[[Finding], str | None]:
+    """Words a failed `published.*` finding at its line of the spec (check/published_numbers)."""
+    path, shown = find_spec(target)
+    doc = load_yaml(path, display=str(path) if not shown.startswith("robots/") else shown)
+    return lambda finding: published_numbers.explain(finding, doc)
 
 
 #: Libraries whose versions appear in, or shape, the emitted bytes (part of the emit key).
@@ -396,8 +404,6 @@ def _stage_and_publish(
         findings = run_checks_cached(staged_kit, files, cache, source)
         failed = [f for f in findings if not f.ok]
         if failed:
-            lines = "; ".join(f.line() for f in failed[:3])
-            more = f" (and {len(failed) - 3} more)" if len(failed) > 3 else ""
-            raise CheckFailed(f"{robot.name}: {len(failed)} check(s) failed: {lines}{more}")
+            raise CheckFailed(failure_message(robot.name, failed, _explainer(target)))
     changed = atomic.commit(staging, out_dir, robot.name)  # kit and zip as one unit
     return files, findings, changed

@@ -28,6 +28,7 @@ _REGISTRY: dict[str, str] = {
     "urdf": "urdf:check_urdf",
     "collision": "geometry:check_collision",
     "glb": "geometry:check_glb",
+    "connected": "connected:check_connected",
     "ros": "ros:check_ros",
     "hold": "mujoco:check_hold",
     "legged": "legged:check_legged",

@@ -196,6 +196,7 @@ def _urdf_inverse_dynamics(
         peak / scale,
         1e-6,
         "",
+        names,
     )
 
 
@@ -390,6 +391,7 @@ def check_accelerations(kit: Kit) -> list[Finding]:
                 recorded / acc,
                 ACC_REL_TOL,
                 "",
+                names,
             )
         )
     per_joint = [joints[n]["derived_max_acceleration"] for n in names]
@@ -401,6 +403,7 @@ def check_accelerations(kit: Kit) -> list[Finding]:
             block["stretched_rated_payload"]["rad_s2"],
             0.0,
             "rad/s^2",
+            names,
         )
     )
     return out

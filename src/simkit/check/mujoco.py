@@ -76,10 +76,14 @@ def check_models(kit: Kit) -> list[Finding]:
     mass_mj = [float(mj.body_mass[mj.body(n).id]) for n in links]
     mass_ur = [float(ur.body_mass[ur.body(n).id]) for n in links]
     findings.append(
-        compare("mass.mjcf", "per-link mass, MJCF vs robot.json", mass_json, mass_mj, 1e-6, "kg")
+        compare(
+            "mass.mjcf", "per-link mass, MJCF vs robot.json", mass_json, mass_mj, 1e-6, "kg", links
+        )
     )
     findings.append(
-        compare("mass.urdf", "per-link mass, URDF vs robot.json", mass_json, mass_ur, 1e-6, "kg")
+        compare(
+            "mass.urdf", "per-link mass, URDF vs robot.json", mass_json, mass_ur, 1e-6, "kg", links
+        )
     )
     inertia_mj = [mj.body_inertia[mj.body(n).id] for n in links]
     inertia_ur = [ur.body_inertia[ur.body(n).id] for n in links]
@@ -91,6 +95,7 @@ def check_models(kit: Kit) -> list[Finding]:
             inertia_ur,
             1e-7,
             "kg m^2",
+            links,
         )
     )
     findings.extend(_inertials(kit, links, mj, ur))
@@ -209,6 +214,7 @@ def _inertials(kit: Kit, links: list[str], mj: mujoco.MjModel, ur: mujoco.MjMode
                 [com for com, _ in frames],
                 1e-6,
                 "m",
+                links,
             )
         )
         out.append(
@@ -219,6 +225,7 @@ def _inertials(kit: Kit, links: list[str], mj: mujoco.MjModel, ur: mujoco.MjMode
                 [tensor for _, tensor in frames],
                 1e-7,
                 "kg m^2",
+                links,
             )
         )
     return out
@@ -274,6 +281,7 @@ def check_hold(kit: Kit) -> list[Finding]:
                 error,
                 HOLD_TOLERANCE_DEG,
                 "deg",
+                names,
             )
         )
         findings.append(
@@ -307,6 +315,7 @@ def check_parameters(kit: Kit) -> list[Finding]:
             [mj.jnt_range[i] if mj.jnt_limited[i] else (np.nan, np.nan) for _, i in limited],
             PARAM_TOL,
             "rad or m",
+            [j["name"] for j, _ in limited],
         ),
         compare(
             "mjcf.joint_dynamics",
@@ -317,6 +326,7 @@ def check_parameters(kit: Kit) -> list[Finding]:
             ),
             PARAM_TOL,
             "SI",
+            [j["name"] for j in joints],
         ),
         _excludes(kit, mj),
     ]
@@ -357,6 +367,7 @@ def _servos(kit: Kit, mj: mujoco.MjModel, servos: list[dict]) -> list[Finding]:
             [[act.gainprm[0], -act.biasprm[2]] for act in acts],
             PARAM_TOL,
             "N m/rad, N m s/rad",
+            [a["joint"] for a in servos],
         ),
         compare(
             "mjcf.forcerange",
@@ -368,6 +379,7 @@ def _servos(kit: Kit, mj: mujoco.MjModel, servos: list[dict]) -> list[Finding]:
             ],
             PARAM_TOL,
             "N m or N",
+            [a["joint"] for a in servos],
         ),
         compare(
             "mjcf.ctrlrange",
@@ -376,6 +388,7 @@ def _servos(kit: Kit, mj: mujoco.MjModel, servos: list[dict]) -> list[Finding]:
             [act.ctrlrange if act.ctrllimited[0] else (np.nan, np.nan) for _, act in limited],
             PARAM_TOL,
             "rad or m",
+            [a["joint"] for a, _ in limited],
         ),
     ]
 

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
 from simkit.check.findings import Finding, compare
 from simkit.check.kit import Kit
 from simkit.kitio.fmt import SIGNIFICANT_DIGITS
+from simkit.spec.load import SourceDoc
 
 LENGTH_TOL = 1e-4  # m: the published numbers must match to 0.1 mm
 MASS_TOL = 0.01  # kg
@@ -46,7 +50,9 @@ def rounding_bound(kit: Kit, q) -> tuple[float, float]:
 
 
 def check_published(kit: Kit) -> list[Finding]:
-    doc, pub = kit.doc, kit.doc.get("published", {})
+    """robot.json's FK reference poses against its own joints, and each published figure
+    against the model (`published_values`)."""
+    doc = kit.doc
     findings: list[Finding] = []
     for ref in doc.get("fk_reference", []):
         if doc.get("tool_frame") in ref:
@@ -73,57 +79,78 @@ def check_published(kit: Kit) -> list[Finding]:
                     "",
                 )
             )
+    findings += [
+        compare(p.check, p.detail, p.published, p.model, p.tolerance, p.unit)
+        for p in published_values(kit)
+    ]
+    return findings
+
+
+@dataclass(frozen=True)
+class Published:
+    """One published figure beside the model's: `field` is its key under the spec's
+    `published:` block, `published` the spec's value, `model` the kit's (robot.json)."""
+
+    field: str
+    check: str
+    detail: str
+    published: Any
+    model: Any
+    tolerance: float
+    unit: str
+
+    @property
+    def ok(self) -> bool:
+        return compare("", "", self.published, self.model, self.tolerance, self.unit).ok
+
+
+def published_values(kit: Kit) -> list[Published]:
+    """Every published figure robot.json carries, with the model's value computed from
+    robot.json alone: the one computation behind `check_published` and
+    `simkit build --accept-published`."""
+    doc, pub = kit.doc, kit.doc.get("published", {})
+    out: list[Published] = []
+
+    def add(field: str, suffix: str, what: str, model: Any, tolerance: float, unit: str):
+        check = f"published.{field}{suffix}"
+        out.append(Published(field, check, what, pub[field], model, tolerance, unit))
+
     if "mass" in pub:
         total = sum(link["mass"] for link in doc["links"])
-        findings.append(
-            compare("published.mass", "sum of link masses", pub["mass"], total, MASS_TOL, "kg")
-        )
+        add("mass", "", "sum of link masses", total, MASS_TOL, "kg")
     if "tool0_home" in pub and doc.get("home") is not None:
-        findings.append(
-            compare(
-                "published.tool0_home",
-                "tool0 at home in base_link",
-                pub["tool0_home"],
-                kit.fk(doc["home"])[:3, 3],
-                LENGTH_TOL,
-                "m",
-            )
-        )
+        tool = [float(v) for v in kit.fk(doc["home"])[:3, 3]]
+        add("tool0_home", "", "tool0 at home in base_link", tool, LENGTH_TOL, "m")
     if "base_link_height" in pub:
         height = doc["frames"].get(doc["base_frame"], {}).get("height")
-        findings.append(
-            compare(
-                "published.base_link_height",
-                f"{doc['base_frame']} above the root",
-                pub["base_link_height"],
-                height if height is not None else np.nan,
-                LENGTH_TOL,
-                "m",
-            )
-        )
-    geometric = (doc.get("reach") or {}).get("geometric") or {}
+        what = f"{doc['base_frame']} above the root"
+        add("base_link_height", "", what, np.nan if height is None else height, LENGTH_TOL, "m")
     if "wrist_centre_reach" in pub:
-        findings.append(
-            compare(
-                "published.wrist_centre_reach",
-                "wrist centre from the J1 axis, stretched",
-                pub["wrist_centre_reach"],
-                geometric.get("wrist", np.nan),
-                LENGTH_TOL,
-                "m",
-            )
-        )
+        geometric = (doc.get("reach") or {}).get("geometric") or {}
+        what = "wrist centre from the J1 axis, stretched"
+        add("wrist_centre_reach", "", what, geometric.get("wrist", np.nan), LENGTH_TOL, "m")
         stretched = doc["poses"].get("stretched")
         if stretched is not None and doc.get("wrist_centre"):
             centre = kit.fk(stretched, doc["wrist_centre"])[:3, 3]
-            findings.append(
-                compare(
-                    "published.wrist_centre_reach.fk",
-                    "wrist centre from robot.json FK, stretched",
-                    pub["wrist_centre_reach"],
-                    float(np.hypot(centre[0], centre[1])),
-                    LENGTH_TOL,
-                    "m",
-                )
-            )
-    return findings
+            what = "wrist centre from robot.json FK, stretched"
+            reach = float(np.hypot(centre[0], centre[1]))
+            add("wrist_centre_reach", ".fk", what, reach, LENGTH_TOL, "m")
+    return out
+
+
+def explain(finding: Finding, spec: SourceDoc) -> str | None:
+    """A failed `published.*` finding as what it means and what to do, at the spec's line:
+    the spec publishes a value the model no longer gives. None for any other finding."""
+    parts = finding.check.split(".")
+    if finding.ok or parts[0] != "published" or len(parts) < 2:
+        return None
+    field = parts[1]
+    line = spec.lines.get(("published", field))
+    where = f"{spec.file}:{line}" if line is not None else spec.file
+    unit = f" {finding.unit}" if finding.unit else ""
+    return (
+        f"{where}: published.{field}: the spec publishes {finding.expected}{unit}, the model "
+        f"gives {finding.actual}{unit} ({finding.detail.split(' (worst')[0]}; tolerance "
+        f"{finding.tolerance}{unit}): correct that line, or build again with "
+        f"--accept-published to write the model's value there"
+    )

@@ -82,9 +82,23 @@ def _inertials(sdf: Tree, urdf: Tree) -> list[Finding]:
     a, b = [sdf.bodies[n] for n in names], [urdf.bodies[n] for n in names]
     what = f"{len(names)} links, SDF vs URDF"
     return [
-        compare("sdf.mass", f"mass of {what}", [x.mass for x in b], [x.mass for x in a], TOL, "kg"),
         compare(
-            "sdf.com", f"centre of mass of {what}", [x.com for x in b], [x.com for x in a], TOL, "m"
+            "sdf.mass",
+            f"mass of {what}",
+            [x.mass for x in b],
+            [x.mass for x in a],
+            TOL,
+            "kg",
+            names,
+        ),
+        compare(
+            "sdf.com",
+            f"centre of mass of {what}",
+            [x.com for x in b],
+            [x.com for x in a],
+            TOL,
+            "m",
+            names,
         ),
         compare(
             "sdf.inertia",
@@ -93,6 +107,7 @@ def _inertials(sdf: Tree, urdf: Tree) -> list[Finding]:
             [x.inertia for x in a],
             TOL,
             "kg m^2",
+            names,
         ),
     ]
 

@@ -80,6 +80,7 @@ def _joint_findings(kit: Kit, urdf) -> list[Finding]:
             [[read(j["name"], "limit", k, nan) for k in ("lower", "upper")] for j in limited],
             TOL,
             "rad or m",
+            [j["name"] for j in limited],
         ),
         compare(
             "urdf.effort",
@@ -88,6 +89,7 @@ def _joint_findings(kit: Kit, urdf) -> list[Finding]:
             [read(j["name"], "limit", "effort", nan) for j in movable],
             TOL,
             "N m or N",
+            [j["name"] for j in movable],
         ),
         compare(
             "urdf.velocity",
@@ -96,6 +98,7 @@ def _joint_findings(kit: Kit, urdf) -> list[Finding]:
             [read(j["name"], "limit", "velocity", nan) for j in movable],
             TOL,
             "rad/s or m/s",
+            [j["name"] for j in movable],
         ),
         compare(
             "urdf.dynamics",
@@ -107,6 +110,7 @@ def _joint_findings(kit: Kit, urdf) -> list[Finding]:
             ],
             TOL,
             "SI",
+            [j["name"] for j in movable],
         ),
     ]
 

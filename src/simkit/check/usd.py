@@ -90,6 +90,7 @@ def _mass_findings(stage, mj, links: dict[str, str]) -> list[Finding]:
             act["mass"],
             _tol(exp["mass"]),
             "kg",
+            list(links),
         ),
         compare(
             "usd.com",
@@ -98,6 +99,7 @@ def _mass_findings(stage, mj, links: dict[str, str]) -> list[Finding]:
             act["com"],
             max(_tol(exp["com"]), 1e-7),
             "m",
+            list(links),
         ),
         compare(
             "usd.inertia",
@@ -106,6 +108,7 @@ def _mass_findings(stage, mj, links: dict[str, str]) -> list[Finding]:
             act["inertia"],
             _tol(exp["inertia"]),
             "kg m^2",
+            list(links),
         ),
     ]
 

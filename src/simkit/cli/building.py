@@ -66,6 +66,12 @@ if TYPE_CHECKING:
     help="Leave out step/NAME.step (the STEP assembly; saves the Open CASCADE time).",
 )
 @click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
+@click.option(
+    "--accept-published",
+    is_flag=True,
+    help="First write the model's values into the spec's published: block where they "
+    "disagree (only those values; comments and layout kept), and print each change.",
+)
 def build(
     targets: tuple[str, ...],
     out_dir: Path,
@@ -79,8 +85,22 @@ def build(
     usd_format: str,
     no_step: bool,
     on_ray: bool,
+    accept_published: bool,
 ) -> None:
     """Build kits for robot NAMEs (see `simkit list`) or spec files (PATH.yaml)."""
+    if accept_published:  # cli/accepting.py: rewrite the specs, then build them as usual
+        from simkit.cli.accepting import accept_published as accept
+
+        cache_ = _open_cache(cache_dir, no_cache, cache_readonly, remote_cache)
+        for target in targets:
+            if not quiet:
+                err.print(f"[{target}] --accept-published: an unchecked build first", markup=False)
+            try:
+                lines = accept(target, usd_format, not no_step, cache_)
+            except SimkitError as exc:
+                fail(exc)
+            for line in lines:
+                out.print(line, markup=False)
     if on_ray:
         options = {"check": not no_check, "usd_format": usd_format, "step": not no_step}
         # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)

@@ -1,7 +1,8 @@
 """Load a spec file and validate it: schema first (pydantic), then cross-references.
 
-All problems are collected; the first (in file order) is reported with its file, line and
-field, plus a count of the rest, as yourdfpy's validation does.
+All problems of a stage are collected and reported in file order, each on its own line
+`FILE:LINE: field: message` at the line of its key (up to `MAX_LISTED`), as yourdfpy's
+validation collects them; a single problem is one line.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from simkit.spec import sim as spec_sim
 from simkit.spec import urdf_blocks as spec_urdf_blocks
 from simkit.spec.load import Loc, SourceDoc, dotted, load_yaml
 from simkit.spec.schema import InertiaSpec, RobotSpec, depth_first
+from simkit.spec.suggest import did_you_mean
 
 Problem = tuple[Loc, str]
 
@@ -288,13 +290,21 @@ def _cycles(spec: RobotSpec) -> Iterator[Problem]:
         rooted |= seen
 
 
+#: spec problems listed, one per line, before "(and N more errors not shown)"
+MAX_LISTED = 20
+
+
 def _first(problems: list[Problem], doc: SourceDoc) -> SpecError:
+    """Every problem in file order (up to `MAX_LISTED`), each at the line of its key, as one
+    `SpecError`: the first is its head, the rest its `others`."""
     located = sorted(
         ((doc.line_of(loc) or 0, i, loc, msg) for i, (loc, msg) in enumerate(problems)),
         key=lambda item: (item[0], item[1]),
     )
-    line, _, loc, msg = located[0]
-    return SpecError(doc.file, line or None, dotted(loc), msg, more=len(problems) - 1)
+    listed = [(line or None, dotted(loc), msg) for line, _, loc, msg in located[:MAX_LISTED]]
+    (line, field, msg), others = listed[0], tuple(listed[1:])
+    more = max(0, len(located) - MAX_LISTED)
+    return SpecError(doc.file, line, field, msg, more=more, others=others)
 
 
 def _pydantic_problems(exc: ValidationError) -> list[Problem]:
@@ -303,7 +313,7 @@ def _pydantic_problems(exc: ValidationError) -> list[Problem]:
         loc = tuple(part for part in err["loc"] if not str(part).startswith("function-"))
         msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
-            msg = "unknown field"
+            msg = "unknown field" + did_you_mean(RobotSpec, loc)
         elif err["type"] == "missing":
             msg = "required field is missing"
         problems.append((loc, msg))
