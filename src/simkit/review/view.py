@@ -35,6 +35,7 @@ TYPES = {
     ".stl": "model/stl",
     ".obj": "model/obj",
     ".png": "image/png",
+    ".wasm": "application/wasm",  # MuJoCo's WebAssembly build: compiled while it streams
 }
 
 
