@@ -84,7 +84,7 @@ def gallery(index: dict) -> str:
         rows = "".join(f"<dt>{k}</dt><dd>{v}</dd>" for k, v in facts if v)
         cards.append(
             f'<article class="card" data-kit="{e(kit["name"])}"><a href="{e(folder)}index.html">'
-            f'{picture}<h2>{e(kit["title"])}</h2></a><dl>{rows}</dl></article>'
+            f"{picture}<h2>{e(kit['title'])}</h2></a><dl>{rows}</dl></article>"
         )
     return _t("gallery.html").substitute(count=len(index["kits"]), cards="\n".join(cards))
 
@@ -134,7 +134,8 @@ def _frames(doc: dict) -> str:
 
 
 def _numbers(doc: dict) -> str:
-    rows = [[f"<code>{e(k)}</code>", _num(v)] for k, v in sorted((doc.get("published") or {}).items())]
+    published = sorted((doc.get("published") or {}).items())
+    rows = [[f"<code>{e(k)}</code>", _num(v)] for k, v in published]
     mass = doc.get("mass")
     if isinstance(mass, dict):
         rows += [[f"<code>mass.{e(k)}</code>", _num(v, "kg")] for k, v in sorted(mass.items())]

@@ -153,4 +153,3 @@ def facts(files: dict[str, bytes], findings) -> dict:
         "thumbnail": thumbnail(files, entries),
         "checks": checks(findings),
     }
-
