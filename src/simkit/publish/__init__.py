@@ -36,7 +36,7 @@ from simkit.errors import SimkitError
 from simkit.kitio import atomic, interrupt, layout, reuse
 from simkit.kitio.jsonout import dumps
 from simkit.kitio.resources import robot_names
-from simkit.pipeline import build, find_spec, write_tree
+from simkit.pipeline import BuildResult, build, find_spec, write_tree
 from simkit.publish import registry
 from simkit.publish.site import Pictures, write_pages
 from simkit.spec.validate import load_spec
@@ -75,16 +75,21 @@ def publish(
     progress: Callable[[str], None] | None = None,
     on_ray: bool = False,
     pictures: Pictures | None = None,
+    built: Sequence[BuildResult] | None = None,
     **build_options,
 ) -> dict:
     """Build `targets` (default: every robot in robots/), check them, and write the site
     folder; returns the index. `build_options` go to `build.build` (cache, jobs); `on_ray`:
     one Ray task per robot (simkit/cluster.py), the site still written here. `pictures`:
-    kit folder -> {pose: PNG} for the kit pages (the CLI passes simkit render's)."""
+    kit folder -> {pose: PNG} for the kit pages (the CLI passes simkit render's). `built`:
+    kits already built and checked (their robot names are the targets), published as they
+    are instead of building `targets`."""
     say = progress or (lambda _msg: None)
     out_dir = Path(out_dir)
     _check_out_dir(out_dir)
-    names = list(targets) if targets else robot_names()
+    names = [r.robot for r in built] if built else list(targets) if targets else robot_names()
+    if built:
+        build_options = {**build_options, "built": list(built)}
     with atomic.locked(out_dir.parent):  # one publish at a time; makes the parent (one line)
         atomic.recover_folder(out_dir)
         options = {**build_options, "on_ray": on_ray}
@@ -165,6 +170,8 @@ def _build_all(names: list[str], work: Path, say: Callable[[str], None], options
     """Every kit, built here one after another or as Ray tasks (`on_ray`), published into
     `work` either way."""
     options = dict(options)
+    if options.get("built"):
+        return options["built"]
     if options.pop("on_ray", False):
         from simkit.cluster import build_on_ray
 
