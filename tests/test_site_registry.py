@@ -38,7 +38,7 @@ def test_a_floating_base_with_two_limbs_is_legged_without_them_floating():
 
 def test_a_fixed_joint_does_not_count_as_a_branch_or_a_degree_of_freedom():
     arm = {
-        "joints": _chain("a", "base", 2) + [_joint("cam", "base", "camera", "fixed")],
+        "joints": [*_chain("a", "base", 2), _joint("cam", "base", "camera", "fixed")],
         "fixed_joints": [{"name": "tcp", "parent": "a1", "child": "tool0"}],
     }
     assert registry.category(arm) == "arm" and registry.dof(arm) == 2
