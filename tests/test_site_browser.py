@@ -8,6 +8,7 @@ holding it (docs/publish.md gives the measured agreement and the tolerance)."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -54,14 +55,9 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.fixture(scope="module")
-def site(seed_kits, tmp_path_factory):
-    """(site folder, index, base URL): the seed kits published and served on 127.0.0.1."""
-    from simkit.publish import publish
-    from simkit.review.view import pose_pictures
-
-    folder = tmp_path_factory.mktemp("site") / "sim"
-    index = publish(folder, built=list(seed_kits.values()), pictures=pose_pictures)
+@contextlib.contextmanager
+def _serve_folder(folder: Path):
+    """`python -m http.server` on 127.0.0.1 serving `folder`; yields its base URL."""
     port = _free_port()
     server = subprocess.Popen(
         [sys.executable, "-m", "http.server", str(port), "-b", "127.0.0.1", "-d", str(folder)],
@@ -76,10 +72,22 @@ def site(seed_kits, tmp_path_factory):
         except OSError:
             time.sleep(0.1)
     try:
-        yield folder, index, base
+        yield base
     finally:
         server.terminate()
         server.wait(10)
+
+
+@pytest.fixture(scope="module")
+def site(seed_kits, tmp_path_factory):
+    """(site folder, index, base URL): the seed kits published and served on 127.0.0.1."""
+    from simkit.publish import publish
+    from simkit.review.view import pose_pictures
+
+    folder = tmp_path_factory.mktemp("site") / "sim"
+    index = publish(folder, built=list(seed_kits.values()), pictures=pose_pictures)
+    with _serve_folder(folder) as base:
+        yield folder, index, base
 
 
 @pytest.fixture(scope="module")

@@ -181,7 +181,7 @@ def _pictures(kit: dict, pictures: dict[str, str]) -> str:
     if not pictures:
         return "<p>none</p>"
     figs = [
-        f'<figure><img src="{e(url)}" alt="{e(pose)}" loading="lazy">'
+        f'<figure><img src="{e(url)}" alt="{e(pose)}">'
         f"<figcaption>{e(pose)}</figcaption></figure>"
         for pose, url in sorted(pictures.items())
     ]

@@ -16,7 +16,7 @@ import { geomMesh } from './geoms.js';
 const MAX_STEPS_PER_FRAME = 200;  // a slow machine runs behind real time, never freezes
 const MAX_CONTACTS = 64;
 let settle;
-const api = { error: null, ready: new Promise((ok, no) => { settle = { ok, no }; }) };
+const api = { error: null, firstFrame: null, ready: new Promise((ok, no) => { settle = { ok, no }; }) };
 api.ready.catch(() => {});  // the error is shown on the page and in api.error
 window.simkitViewer = api;
 
@@ -414,6 +414,7 @@ async function main() {
     if (wall !== null && !sim.paused) {
       const goal = sim.data.time + Math.min((now - wall) / 1000, 0.1);
       for (let i = 0; i < MAX_STEPS_PER_FRAME && sim.data.time < goal; i++) sim.step(1);
+      if (api.firstFrame === null && sim.data.time > 0) api.firstFrame = performance.now();
     }
     wall = now;
     draw();
