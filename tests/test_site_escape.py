@@ -1,6 +1,7 @@
 """Issue 40: a hostile robot on the site. A copy of a test spec whose title, description and
-a named pose are markup (the robot name itself is `[a-z][a-z0-9_]*` in the schema) is
-published and opened in Chromium: everything shows as text, no script runs, no dialog opens."""
+licence are markup (the free-text fields: robot, joint, link and pose names are identifiers
+in the schema) is published and opened in Chromium: everything shows as text, no script runs,
+no dialog opens."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import pytest
 from test_site_browser import CHROMIUM, FLAGS, _need_browser, _open, _serve_folder
 
 TITLE = '<script>alert("title")</script>'
-POSE = "<img src=x onerror=alert(1)>"
+LICENCE = "<img src=x onerror=alert(1)>"
 SPECS = Path(__file__).resolve().parent / "specs"
 
 
@@ -23,9 +24,10 @@ def test_a_robot_titled_script_shows_as_text(tmp_path):
     from simkit.review.view import pose_pictures
 
     text = (SPECS / "planar_2r.yaml").read_text()
-    assert "title: Planar 2R\n" in text and "  work: [30, 30]\n" in text
-    text = text.replace("title: Planar 2R\n", f"title: '{TITLE}'\ndescription: '{TITLE}'\n")
-    text = text.replace("  work: [30, 30]\n", f"  '{POSE}': [30, 30]\n")
+    assert "title: Planar 2R\n" in text and "license:" not in text
+    text = text.replace(
+        "title: Planar 2R\n", f"title: '{TITLE}'\ndescription: '{TITLE}'\nlicense: '{LICENCE}'\n"
+    )
     spec = tmp_path / "planar_2r.yaml"
     spec.write_text(text)
     site = tmp_path / "sim"
@@ -41,16 +43,20 @@ def test_a_robot_titled_script_shows_as_text(tmp_path):
         page = _open(browser, base + "index.html", problems)
         page.on("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
         assert page.locator("article.card h2").text_content() == TITLE
+        assert page.locator("article.card dd", has_text=LICENCE).count() == 1
         page = _open(browser, base + kit["page"], problems)
         page.on("dialog", lambda d: (dialogs.append(d.message), d.dismiss()))
         page.evaluate("window.simkitViewer.ready")
         assert page.locator("#kit-title").text_content() == TITLE
         assert page.title().startswith(TITLE)
-        assert page.locator("button[data-pose]").all_text_contents() == ["home", POSE, "stretched"]
-        assert page.locator(f"#pictures figcaption:text-is('{POSE}')").count() == 1
+        assert LICENCE in page.locator("header p.facts").text_content()
+        assert page.locator("#pictures figcaption").all_text_contents() == [
+            "home",
+            "stretched",
+            "work",
+        ]
         assert page.evaluate("document.querySelectorAll('script').length") == 3
         assert page.evaluate("document.querySelectorAll('img[src=x]').length") == 0
-        page.evaluate(f"simkitViewer.pose({POSE!r})")  # the pose still works by its name
         browser.close()
     assert dialogs == [] and problems == []
     shutil.rmtree(site)
