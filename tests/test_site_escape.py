@@ -52,8 +52,8 @@ def test_a_robot_titled_script_shows_as_text(tmp_path):
         assert LICENCE in page.locator("header p.facts").text_content()
         assert page.locator("#pictures figcaption").all_text_contents() == [
             "home",
-            "stretched",
             "work",
+            "stretched",
         ]
         assert page.evaluate("document.querySelectorAll('script').length") == 3
         assert page.evaluate("document.querySelectorAll('img[src=x]').length") == 0

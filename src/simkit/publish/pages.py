@@ -181,9 +181,8 @@ def _pictures(kit: dict, pictures: dict[str, str]) -> str:
     if not pictures:
         return "<p>none</p>"
     figs = [
-        f'<figure><img src="{e(url)}" alt="{e(pose)}">'
-        f"<figcaption>{e(pose)}</figcaption></figure>"
-        for pose, url in sorted(pictures.items())
+        f'<figure><img src="{e(url)}" alt="{e(pose)}"><figcaption>{e(pose)}</figcaption></figure>'
+        for pose, url in pictures.items()  # robot.json's pose order
     ]
     return '<div class="pictures">' + "".join(figs) + "</div>"
 

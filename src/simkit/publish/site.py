@@ -46,11 +46,11 @@ def viewer_files() -> dict[str, bytes]:
 
 
 def picture_urls(folder: str, pictures: dict[str, bytes]) -> dict[str, str]:
-    """pose -> site path of its PNG; a pose whose name is not a safe file name gets its
-    position in the sorted list instead (the caption still names it)."""
+    """pose -> site path of its PNG, in the renderer's order (robot.json's); a pose whose
+    name is not a safe file name gets its position instead (the caption still names it)."""
     return {
         pose: f"pictures/{folder}/{pose if SAFE_NAME.match(pose) else f'pose_{i}'}.png"
-        for i, pose in enumerate(sorted(pictures))
+        for i, pose in enumerate(pictures)
     }
 
 
