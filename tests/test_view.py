@@ -17,7 +17,7 @@ import pytest
 
 from simkit.errors import SimkitError
 from simkit.kitio.resources import robot_names
-from simkit.review.view import WEB, serve_kit, start_server
+from simkit.review.view import WEB, serve_kit, start_server, start_site_server
 
 CHROMIUM = os.environ.get("SIMKIT_CHROMIUM") or shutil.which("chromium")
 FLAGS = [
@@ -286,3 +286,26 @@ def test_viewer_frames_the_whole_robot_in_every_pose(kit_factory, name, tmp_path
         lo, hi = np.array(box["lo"]), np.array(box["hi"])
         assert (lo >= -1).all() and (hi <= 1).all(), f"{name} {pose}: leaves the canvas {box}"
         assert ((hi - lo) / 2).max() > 0.3, f"{name} {pose}: the robot is a speck {box}"
+
+
+def test_publish_serve_is_a_static_server_of_the_site_on_loopback(tmp_path):
+    """`simkit publish --serve`: the site folder as files, nothing outside it, 127.0.0.1."""
+    site = tmp_path / "sim"
+    (site / "viewer").mkdir(parents=True)
+    (site / "index.html").write_text("<!DOCTYPE html><title>kits</title>")
+    (site / "viewer" / "mujoco.wasm").write_bytes(b"\0asm")
+    (tmp_path / "secret.txt").write_text("not for the browser")
+    server = start_site_server(site, 0)
+    host, port = server.server_address[:2]
+    base = f"http://127.0.0.1:{port}"
+    try:
+        assert host == "127.0.0.1"
+        assert _get(base + "/")[1] == (site / "index.html").read_bytes()
+        status, body, ctype = _get(base + "/viewer/mujoco.wasm")
+        assert (status, body, ctype) == (200, b"\0asm", "application/wasm")
+        assert _get(base + "/../secret.txt")[0] == 404
+    finally:
+        server.shutdown()
+        server.server_close()
+    with pytest.raises(SimkitError, match="no such site folder"):
+        start_site_server(tmp_path / "missing", 0)

@@ -184,9 +184,9 @@ def pose_pictures(kit: Path) -> dict[str, bytes]:
         return {path.stem: path.read_bytes() for path in paths}
 
 
-def serve_site(folder: Path, port: int, say: Callable[[str], None] | None = None) -> None:
-    """`simkit publish --serve`: the site folder as a plain static server on 127.0.0.1 (what
-    `python -m http.server -b 127.0.0.1 -d FOLDER` does), until Ctrl-C."""
+def start_site_server(folder: Path, port: int = 0) -> ThreadingHTTPServer:
+    """A plain static server of `folder` on 127.0.0.1:`port` (what `python -m http.server -b
+    127.0.0.1 -d FOLDER` does, without the access log) from a daemon thread."""
     from functools import partial
     from http.server import SimpleHTTPRequestHandler
 
@@ -194,11 +194,19 @@ def serve_site(folder: Path, port: int, say: Callable[[str], None] | None = None
         def log_message(self, format: str, *args) -> None:
             return
 
+    if not folder.is_dir():
+        raise SimkitError(f"{folder}: no such site folder")
     try:
         server = ThreadingHTTPServer(("127.0.0.1", port), partial(Quiet, directory=str(folder)))
     except OSError as exc:
         raise SimkitError(f"--port {port}: cannot listen on 127.0.0.1 ({exc.strerror})") from None
     threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server
+
+
+def serve_site(folder: Path, port: int, say: Callable[[str], None] | None = None) -> None:
+    """`simkit publish --serve`: the site folder on 127.0.0.1 until Ctrl-C."""
+    server = start_site_server(folder, port)
     try:
         if say is not None:
             say(f"serving {folder} at http://127.0.0.1:{server.server_address[1]}/ (Ctrl-C stops)")
