@@ -122,7 +122,9 @@ def test_zip_with_a_file_and_a_folder_of_one_name_is_one_line(tmp_path):
 
 def test_page_and_vendored_files_reference_nothing_outside():
     """No URL with a scheme in what the page loads (three.js's comments aside)."""
-    page = "".join((WEB / name).read_text() for name in ("index.html", "viewer.js", "geoms.js"))
+    page = "".join(
+        (WEB / name).read_text() for name in ("index.html", "viewer.js", "geoms.js", "camera.js")
+    )
     assert "http:" not in page and "https:" not in page
     assert "@mujoco/mujoco@3.14.0" in (WEB / "vendor/mujoco/README.md").read_text()
     assert (WEB / "vendor/mujoco/LICENSE").read_text().lstrip().startswith("Apache License")

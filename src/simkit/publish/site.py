@@ -8,7 +8,7 @@ Layout (in the site folder, beside index.json and the zips):
     site.css                   the pages' style
     <asset_dir>/index.html     the kit's page, beside the kit's files
     pictures/<asset_dir>/<pose>.png   the kit at each named pose (when a renderer is given)
-    viewer/                    viewer.js, geoms.js, vendor/three/, vendor/mujoco/
+    viewer/                    viewer.js, geoms.js, camera.js, vendor/three/, vendor/mujoco/
 
 The viewer's files are those of `simkit view` (simkit/review/web, read as package data: the
 publish layer imports nothing from review).
@@ -28,7 +28,7 @@ from simkit.publish import pages
 
 #: simkit view's page files, shared with the site (package data of simkit.review)
 WEB = Path(__file__).resolve().parents[1] / "review" / "web"
-VIEWER_FILES = ("viewer.js", "geoms.js")
+VIEWER_FILES = ("viewer.js", "geoms.js", "camera.js")
 PAGE = "index.html"
 SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
