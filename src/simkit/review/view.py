@@ -180,7 +180,10 @@ def pose_pictures(kit: Path) -> dict[str, bytes]:
     from simkit.review.render import render_kit
 
     with tempfile.TemporaryDirectory(prefix="simkit-pictures-") as tmp:
-        paths = render_kit(kit, Path(tmp) / "pictures")
+        try:
+            paths = render_kit(kit, Path(tmp) / "pictures")
+        except SimkitError as exc:  # no OpenGL here: say how to publish without pictures
+            raise SimkitError(f"{exc}; or publish with --no-pictures") from None
         return {path.stem: path.read_bytes() for path in paths}
 
 
