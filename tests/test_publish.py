@@ -33,7 +33,39 @@ def test_index_lists_every_file_with_true_size_and_sha256(rosie_1000_published):
         served = (site / entry["url"]).read_bytes()
         assert served == data, entry["url"]
     on_disk = {p.relative_to(site).as_posix() for p in site.rglob("*") if p.is_file()}
-    assert on_disk == {"index.json", kit["zip"]["path"]} | {f["url"] for f in kit["files"]}
+    pages = {"index.html", "site.css", kit["page"]}
+    viewer = {p for p in on_disk if p.startswith("viewer/")}
+    assert "viewer/vendor/mujoco/mujoco.wasm" in viewer and "viewer/viewer.js" in viewer
+    assert on_disk - viewer == {"index.json", kit["zip"]["path"]} | pages | {
+        f["url"] for f in kit["files"]
+    }
+
+
+def test_index_format_2_carries_the_registry_facts_and_keeps_format_1s(rosie_1000_published):
+    """Issue 40: licence, category, DoF, entry points and the checks, as Menagerie's registry;
+    every field of format 1 is still there."""
+    site, index = rosie_1000_published
+    assert index["format"] == 2
+    (kit,) = index["kits"]
+    assert {"name", "title", "folder", "top_folder", "zip", "files"} <= set(kit)
+    doc = json.loads((site / kit["folder"] / "robot.json").read_text())
+    assert kit["category"] == "arm" and kit["dof"] == 6
+    assert kit["licence"] == "LicenseRef-rosie_1000_description"
+    assert kit["mass"] == doc["mass"]["model"]
+    assert kit["entry_points"] == {
+        "mjcf": "mjcf/rosie_1000.xml",
+        "gpu_scene": "mjcf/rosie_1000_mjx.xml",
+        "urdf": "urdf/rosie_1000.urdf",
+        "usd": "usd/rosie_1000.usda",
+        "sdf": "sdf/rosie_1000.sdf",
+        "glb": "glb/rosie_1000.glb",
+    }
+    for path in [*kit["entry_points"].values(), kit["thumbnail"]]:
+        assert (site / kit["folder"] / path).is_file(), path
+    assert kit["checks"]["mjcf"]["tools"] == ["MuJoCo"]
+    assert all(g["passed"] == g["total"] > 0 for g in kit["checks"].values())
+    page = (site / kit["page"]).read_text()
+    assert kit["zip"]["sha256"] in page and "Quickstart" in page
 
 
 def test_publish_refuses_a_folder_that_is_not_a_publication(tmp_path):

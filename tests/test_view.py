@@ -17,7 +17,7 @@ import pytest
 
 from simkit.errors import SimkitError
 from simkit.kitio.resources import robot_names
-from simkit.review.view import WEB, serve_kit, start_server
+from simkit.review.view import WEB, serve_kit, start_server, start_site_server
 
 CHROMIUM = os.environ.get("SIMKIT_CHROMIUM") or shutil.which("chromium")
 FLAGS = [
@@ -122,8 +122,12 @@ def test_zip_with_a_file_and_a_folder_of_one_name_is_one_line(tmp_path):
 
 def test_page_and_vendored_files_reference_nothing_outside():
     """No URL with a scheme in what the page loads (three.js's comments aside)."""
-    page = (WEB / "index.html").read_text() + (WEB / "viewer.js").read_text()
+    page = "".join(
+        (WEB / name).read_text() for name in ("index.html", "viewer.js", "geoms.js", "camera.js")
+    )
     assert "http:" not in page and "https:" not in page
+    assert "@mujoco/mujoco@3.14.0" in (WEB / "vendor/mujoco/README.md").read_text()
+    assert (WEB / "vendor/mujoco/LICENSE").read_text().lstrip().startswith("Apache License")
     assert (WEB / "vendor/three/LICENSE").read_text().startswith("The MIT License")
     assert "three@0.170.0" in (WEB / "vendor/three/README.md").read_text()
 
@@ -133,29 +137,38 @@ def test_refuses_a_folder_that_is_no_kit(tmp_path):
         start_server(tmp_path, 0)
 
 
-def _expected_tool(kit: Path, joint: str, value: float) -> tuple[np.ndarray, np.ndarray]:
-    """tool0 in the URDF root's frame at home and with `joint` at `value`, from the kit's
-    URDF through yourdfpy (independent of the browser and of simkit's kinematics)."""
-    import yourdfpy
+def _servo_hold(kit: Path, joint: str, value: float, steps: int) -> dict:
+    """Python MuJoCo on the kit's MJCF: from home with the servos holding it, `joint`'s servo
+    target set to `value`, `steps` steps -> qpos by joint name and the tool site (world, m)."""
+    import mujoco
 
     doc = json.loads((kit / "robot.json").read_text())
-    urdf = yourdfpy.URDF.load(
-        str(kit / doc["files"]["urdf"]),
-        load_meshes=False,
-        build_collision_scene_graph=False,
-        load_collision_meshes=False,
-    )
+    model = mujoco.MjModel.from_xml_path(str(kit / doc["files"]["mjcf"]))
+    data = mujoco.MjData(model)
     movable = [j["name"] for j in doc["joints"] if j["type"] != "fixed"]
-    home = dict(zip(movable, doc["home"], strict=True))
-    urdf.update_cfg(home)
-    before = urdf.get_transform(doc["tool_frame"], urdf.base_link)[:3, 3]
-    urdf.update_cfg({**home, joint: value})
-    after = urdf.get_transform(doc["tool_frame"], urdf.base_link)[:3, 3]
-    return before, after
+    targets = {**dict(zip(movable, doc["home"], strict=True)), joint: value}
+    for name, q in targets.items():
+        adr = model.joint(name).qposadr[0]
+        data.qpos[adr] = dict(zip(movable, doc["home"], strict=True))[name]
+        for a in range(model.nu):
+            if model.actuator_trnid[a, 0] == model.joint(name).id:
+                data.ctrl[a] = q
+    mujoco.mj_forward(model, data)
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+    qpos = {name: float(data.qpos[model.joint(name).qposadr[0]]) for name in movable}
+    return {"qpos": qpos, "tool": data.site(doc["tool_frame"]).xpos.copy()}
+
+
+def _wait_ready(page) -> None:
+    page.evaluate("window.simkitViewer.ready.catch(() => null)")
+    assert page.evaluate("window.simkitViewer.error") is None
 
 
 @pytest.mark.slow
 def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
+    """The live viewer: sliders and pose buttons from robot.json; a slider sets the servo
+    target and, stepped while paused, the arm moves as Python MuJoCo's does."""
     if CHROMIUM is None:
         missing = "no chromium on PATH (Debian: apt-get install chromium)"
         if os.environ.get("SIMKIT_REQUIRE_RENDER"):  # .ci/run installed it
@@ -168,7 +181,8 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
     doc = json.loads((kit / "robot.json").read_text())
     j2 = [j for j in doc["joints"] if j["type"] != "fixed"][1]  # the second movable joint
     value = round(min(j2["upper"], 0.6), 6)
-    before, after = _expected_tool(kit, j2["name"], value)
+    steps = 750  # 1.5 s at the MJCF's 2 ms
+    expected = _servo_hold(kit, j2["name"], value, steps)
     server = start_server(kit, 0)
     problems: list[str] = []
     try:
@@ -186,10 +200,7 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
                 ),
             )
             page.goto(f"http://127.0.0.1:{server.server_address[1]}/")
-            page.wait_for_function(
-                "window.simkitViewer.ready || window.simkitViewer.error", timeout=120_000
-            )
-            assert page.evaluate("window.simkitViewer.error") is None
+            _wait_ready(page)
             sliders = page.locator("input[type=range][data-joint]")
             assert sliders.count() == len(doc["joints"])
             for joint in doc["joints"]:
@@ -197,35 +208,31 @@ def test_viewer_in_headless_chromium(rosie_1000, tmp_path):
                 assert float(slider.get_attribute("min")) == pytest.approx(joint["lower"])
                 assert float(slider.get_attribute("max")) == pytest.approx(joint["upper"])
             assert page.locator("button[data-pose]").count() == len(doc["poses"])
-            assert page.locator("input[data-frame]").count() == 2
             tool = doc["tool_frame"]
+            page.evaluate("simkitViewer.pause(true); simkitViewer.reset('home')")
             seen_before = np.array(page.evaluate(f"simkitViewer.framePosition('{tool}')"))
             page.eval_on_selector(
                 f'input[data-joint="{j2["name"]}"]',
                 "(s, v) => { s.value = v; s.dispatchEvent(new Event('input', {bubbles: true})); }",
                 value,
             )
+            page.evaluate(f"simkitViewer.step({steps})")
+            seen = page.evaluate("simkitViewer.qpos()")
             seen_after = np.array(page.evaluate(f"simkitViewer.framePosition('{tool}')"))
-            boxes = {}  # issue 25: the camera frames the whole robot in every named pose
-            for pose in doc["poses"]:
-                page.click(f'button[data-pose="{pose}"]')
-                boxes[pose] = page.evaluate("simkitViewer.screenBox()")
-                (tmp_path / f"pose_{pose}.png").write_bytes(page.screenshot())
             page.click('input[data-collision="*"]')
+            page.click('input[data-contacts="*"]')
+            page.evaluate("simkitViewer.step(1)")
             shot = page.screenshot()
             browser.close()
     finally:
         server.shutdown()
         server.server_close()
     assert problems == []
-    for pose, box in boxes.items():
-        lo, hi = np.array(box["lo"]), np.array(box["hi"])
-        assert (lo >= -1).all() and (hi <= 1).all(), f"{pose}: the robot leaves the canvas"
-        assert ((hi - lo) / 2).max() > 0.3, f"{pose}: the robot is a speck"
-    moved = np.linalg.norm(seen_after - seen_before)
-    assert moved == pytest.approx(np.linalg.norm(after - before), abs=1e-3)
-    assert moved > 0.05  # a real move, not a no-op
-    assert np.abs(seen_before - before).max() < 1e-3 and np.abs(seen_after - after).max() < 1e-3
+    for joint, q in expected["qpos"].items():
+        assert seen[joint] == pytest.approx(q, abs=1e-6), joint
+    assert seen[j2["name"]] == pytest.approx(value, abs=0.02)  # the servo got there
+    assert np.abs(seen_after - expected["tool"]).max() < 1e-5
+    assert np.linalg.norm(seen_after - seen_before) > 0.05  # a real move, not a no-op
     image = np.asarray(Image.open(io.BytesIO(shot)).convert("RGB"))
     view = image[:, 320:]  # right of the side panel: the 3D view
     assert view.std() > 10 and len(np.unique(view.reshape(-1, 3), axis=0)) > 200
@@ -266,12 +273,11 @@ def test_viewer_frames_the_whole_robot_in_every_pose(kit_factory, name, tmp_path
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=FLAGS)
             page = browser.new_page(viewport={"width": 900, "height": 600})
             page.goto(f"http://127.0.0.1:{server.server_address[1]}/")
-            page.wait_for_function(
-                "window.simkitViewer.ready || window.simkitViewer.error", timeout=120_000
-            )
-            assert page.evaluate("window.simkitViewer.error") is None
-            for pose in poses:
+            _wait_ready(page)
+            page.evaluate("simkitViewer.pause(true)")
+            for pose in poses:  # the servos drive the robot there: 3 s, stepped while paused
                 page.click(f'button[data-pose="{pose}"]')
+                page.evaluate("simkitViewer.step(Math.round(3 / simkitViewer.timestep()))")
                 boxes[pose] = page.evaluate("simkitViewer.screenBox()")
                 (tmp_path / f"{pose}.png").write_bytes(page.screenshot())
             browser.close()
@@ -282,3 +288,26 @@ def test_viewer_frames_the_whole_robot_in_every_pose(kit_factory, name, tmp_path
         lo, hi = np.array(box["lo"]), np.array(box["hi"])
         assert (lo >= -1).all() and (hi <= 1).all(), f"{name} {pose}: leaves the canvas {box}"
         assert ((hi - lo) / 2).max() > 0.3, f"{name} {pose}: the robot is a speck {box}"
+
+
+def test_publish_serve_is_a_static_server_of_the_site_on_loopback(tmp_path):
+    """`simkit publish --serve`: the site folder as files, nothing outside it, 127.0.0.1."""
+    site = tmp_path / "sim"
+    (site / "viewer").mkdir(parents=True)
+    (site / "index.html").write_text("<!DOCTYPE html><title>kits</title>")
+    (site / "viewer" / "mujoco.wasm").write_bytes(b"\0asm")
+    (tmp_path / "secret.txt").write_text("not for the browser")
+    server = start_site_server(site, 0)
+    host, port = server.server_address[:2]
+    base = f"http://127.0.0.1:{port}"
+    try:
+        assert host == "127.0.0.1"
+        assert _get(base + "/")[1] == (site / "index.html").read_bytes()
+        status, body, ctype = _get(base + "/viewer/mujoco.wasm")
+        assert (status, body, ctype) == (200, b"\0asm", "application/wasm")
+        assert _get(base + "/../secret.txt")[0] == 404
+    finally:
+        server.shutdown()
+        server.server_close()
+    with pytest.raises(SimkitError, match="no such site folder"):
+        start_site_server(tmp_path / "missing", 0)

@@ -233,6 +233,14 @@ def list_robots() -> None:
 @click.option("--cache-readonly", is_flag=True, envvar="SIMKIT_CACHE_READONLY", help="As build's.")
 @click.option("--remote-cache", default=None, envvar="SIMKIT_REMOTE_CACHE", help="As build's.")
 @click.option("--ray", "on_ray", is_flag=True, help=RAY_HELP)
+@click.option(
+    "--pictures/--no-pictures",
+    default=True,
+    show_default=True,
+    help="Render each kit at its named poses for its page (MuJoCo, as simkit render).",
+)
+@click.option("--serve", is_flag=True, help="Then serve the site on 127.0.0.1 (Ctrl-C stops).")
+@click.option("--port", type=click.IntRange(0, 65535), default=8000, show_default=True)
 def publish(
     robots: tuple[str, ...],
     out_dir: Path,
@@ -241,16 +249,23 @@ def publish(
     cache_readonly: bool,
     remote_cache: str | None,
     on_ray: bool,
+    pictures: bool,
+    serve: bool,
+    port: int,
 ) -> None:
-    """Build ROBOTS (default: every robot in robots/) into zips, per-file folders and
-    index.json, as the download site serves them under /assets/sim/."""
+    """Build ROBOTS (default: every robot in robots/) into zips, per-file folders, index.json
+    and the pages (a gallery, one page per kit with the robot live), as the download site
+    serves them under /assets/sim/."""
     from simkit.publish import publish as run_publish
+    from simkit.review.view import pose_pictures, serve_site
 
     if on_ray:  # each worker opens its own cache from these (and its own $SIMKIT_CACHE_KEY)
         args = {"root": cache_dir, "readonly": cache_readonly or None, "remote": remote_cache}
         options = {"on_ray": True, "cache_args": args}
     else:
         options = {"cache": _open_cache(cache_dir, False, cache_readonly, remote_cache)}
+    if pictures:
+        options["pictures"] = pose_pictures
 
     def progress(msg: str) -> None:
         if not quiet:
@@ -262,3 +277,8 @@ def publish(
         fail(exc)
     files = sum(len(kit["files"]) for kit in index["kits"])
     out.print(f"published {len(index['kits'])} kit(s), {files} files, to {out_dir}", markup=False)
+    if serve:
+        try:
+            serve_site(out_dir, port, say)
+        except SimkitError as exc:
+            fail(exc)

@@ -35,6 +35,7 @@ TYPES = {
     ".stl": "model/stl",
     ".obj": "model/obj",
     ".png": "image/png",
+    ".wasm": "application/wasm",  # MuJoCo's WebAssembly build: compiled while it streams
 }
 
 
@@ -171,3 +172,53 @@ def serve_kit(
         finally:
             server.shutdown()
             server.server_close()
+
+
+def pose_pictures(kit: Path) -> dict[str, bytes]:
+    """{pose: PNG} of a built kit at each named pose (`simkit render`'s defaults), for the kit
+    pages of `simkit publish`."""
+    from simkit.review.render import render_kit
+
+    with tempfile.TemporaryDirectory(prefix="simkit-pictures-") as tmp:
+        try:
+            paths = render_kit(kit, Path(tmp) / "pictures")
+        except SimkitError as exc:  # no OpenGL here: say how to publish without pictures
+            raise SimkitError(f"{exc}; or publish with --no-pictures") from None
+        return {path.stem: path.read_bytes() for path in paths}
+
+
+def start_site_server(folder: Path, port: int = 0) -> ThreadingHTTPServer:
+    """A plain static server of `folder` on 127.0.0.1:`port` (what `python -m http.server -b
+    127.0.0.1 -d FOLDER` does, without the access log) from a daemon thread."""
+    from functools import partial
+    from http.server import SimpleHTTPRequestHandler
+
+    class Quiet(SimpleHTTPRequestHandler):
+        def log_message(self, format: str, *args) -> None:
+            return
+
+    if not folder.is_dir():
+        raise SimkitError(f"{folder}: no such site folder")
+    try:
+        server = ThreadingHTTPServer(("127.0.0.1", port), partial(Quiet, directory=str(folder)))
+    except OSError as exc:
+        raise SimkitError(f"--port {port}: cannot listen on 127.0.0.1 ({exc.strerror})") from None
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server
+
+
+def serve_site(folder: Path, port: int, say: Callable[[str], None] | None = None) -> None:
+    """`simkit publish --serve`: the site folder on 127.0.0.1 until Ctrl-C."""
+    server = start_site_server(folder, port)
+    try:
+        if say is not None:
+            say(f"serving {folder} at http://127.0.0.1:{server.server_address[1]}/ (Ctrl-C stops)")
+        threading.Event().wait()
+    except KeyboardInterrupt:
+        pass
+    except interrupt.Interrupted as stop:
+        if stop.signum != signal.SIGINT:
+            raise
+    finally:
+        server.shutdown()
+        server.server_close()

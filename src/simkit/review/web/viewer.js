@@ -1,18 +1,24 @@
-// simkit view: a kit's GLB with joint sliders, named poses, frames and collision pieces.
+// The live viewer of `simkit view` and of the kit pages of `simkit publish`: MuJoCo's
+// WebAssembly build steps the kit's MJCF in real time, three.js draws every geom at its
+// simulated pose. Position servos (the MJCF's actuators) hold the joints: named-pose buttons
+// and the joint sliders set their targets (ctrl). Frames: MuJoCo's world, z up, metres.
 //
-// Kinematics follow the GLB emitter (emit/glb.py): each link node sits on its joint origin,
-// so a joint value q turns the child link node about the joint axis (node frame) by q, or
-// moves it along the axis by q for a prismatic joint. The scene's first node turns the kit's
-// Z-up frames into glTF's Y-up; positions reported by `simkitViewer.framePosition` are in the
-// kit's frame (m), below that node. Everything is fetched from this server: no network.
+// Where the kit comes from: a kit page holds `<script type="application/json"
+// id="simkit-kit">` ({"base": URL of the kit folder, "files": [kit paths]}); without it (the
+// `simkit view` server) the kit is at `kit/` and its file list at `kit-files.json`. Every
+// request stays on this site. The test interface `window.simkitViewer` is documented in
+// docs/publish.md.
 import * as THREE from 'three';
-import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
-import { STLLoader } from 'three/addons/loaders/STLLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import loadMujoco from './vendor/mujoco/mujoco.js';
+import { geomMesh } from './geoms.js';
+import { frameCamera, screenBox } from './camera.js';
 
-const COLLISION_PIECE = /^meshes\/collision\/(.+)_(\d+)\.(stl|obj)$/;
-const PALETTE = [0xf25a1a, 0x1a8cf2, 0x33bf4d, 0xd933b3, 0xf2bf1a];
-const api = { ready: false, error: null, joints: [] };
+const MAX_STEPS_PER_FRAME = 200;  // a slow machine runs behind real time, never freezes
+const MAX_CONTACTS = 64;
+let settle;
+const api = { error: null, firstFrame: null, ready: new Promise((ok, no) => { settle = { ok, no }; }) };
+api.ready.catch(() => {});  // the error is shown on the page and in api.error
 window.simkitViewer = api;
 
 function element(tag, attrs = {}, text = '') {
@@ -22,10 +28,31 @@ function element(tag, attrs = {}, text = '') {
   return node;
 }
 
-async function fetchJson(url) {
+async function fetchOk(url) {
   const response = await fetch(url);
   if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
-  return response.json();
+  return response;
+}
+
+async function kitSource() {
+  const inline = document.getElementById('simkit-kit');
+  if (inline) return JSON.parse(inline.textContent);
+  return { base: 'kit/', files: await (await fetchOk('kit-files.json')).json() };
+}
+
+// The MJCF and every file beside it that it may name (meshes, included XML) into MuJoCo's
+// in-memory file system under /kit; the URDF, USD, STEP... stay on the server.
+async function loadModel(mujoco, source, robot) {
+  const wanted = source.files.filter((p) => p.startsWith('mjcf/') || p.startsWith('meshes/'));
+  const bodies = await Promise.all(wanted.map(async (p) => new Uint8Array(
+    await (await fetchOk(source.base + p)).arrayBuffer())));
+  wanted.forEach((path, i) => {
+    const folder = `/kit/${path.split('/').slice(0, -1).join('/')}`;
+    mujoco.FS.mkdirTree(folder);
+    mujoco.FS.writeFile(`/kit/${path}`, bodies[i]);
+  });
+  const main = robot.files?.mjcf_scene ?? robot.files?.mjcf ?? `mjcf/${robot.name}.xml`;
+  return { model: mujoco.MjModel.from_xml_path(`/kit/${main}`), main };
 }
 
 function setupScene(container) {
@@ -33,193 +60,94 @@ function setupScene(container) {
   renderer.setPixelRatio(window.devicePixelRatio);
   container.appendChild(renderer.domElement);
   const scene = new THREE.Scene();
-  scene.background = new THREE.Color(0x2a3240);  // dark: white robots stand out
+  scene.background = new THREE.Color(0x2a3240);
   scene.add(new THREE.HemisphereLight(0xffffff, 0x8d8f94, 1.6));
   const key = new THREE.DirectionalLight(0xffffff, 1.6);
-  key.position.set(2, 4, 2);
+  key.position.set(2, -2, 4);
   scene.add(key);
-  const fill = new THREE.DirectionalLight(0xffffff, 0.5);
-  fill.position.set(-2, 3, -2);
-  scene.add(fill);
   const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 100);
+  camera.up.set(0, 0, 1);  // MuJoCo's z up
   const controls = new OrbitControls(camera, renderer.domElement);
-  const render = () => renderer.render(scene, camera);
-  controls.addEventListener('change', render);
   const resize = () => {
     const { clientWidth: w, clientHeight: h } = container;
     renderer.setSize(w, h, false);
     camera.aspect = w / Math.max(h, 1);
     camera.updateProjectionMatrix();
-    render();
   };
   new ResizeObserver(resize).observe(container);
-  const aspect = () => container.clientWidth / Math.max(container.clientHeight, 1);
-  return { scene, camera, controls, render, resize, aspect };
+  resize();
+  return { scene, camera, controls, resize, render: () => renderer.render(scene, camera) };
 }
 
-// The visible meshes' vertices in world coordinates (three's frame), after `object`'s
-// current joint values; collision pieces and frame axes count only when shown.
-function visibleVertices(object, visit) {
-  object.updateMatrixWorld(true);
-  const point = new THREE.Vector3();
-  object.traverseVisible((node) => {
-    if (!node.isMesh) return;
-    const positions = node.geometry.attributes.position;
-    for (let i = 0; i < positions.count; i++) {
-      visit(point.fromBufferAttribute(positions, i).applyMatrix4(node.matrixWorld));
+// Name lookups and the joint <-> qpos / actuator maps of the compiled model.
+function indexModel(mujoco, model) {
+  const id = (kind, name) => mujoco.mj_name2id(model, mujoco.mjtObj[kind].value, name);
+  const joints = new Map();
+  for (let j = 0; j < model.njnt; j++) {
+    const name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT.value, j);
+    const type = model.jnt_type[j];  // 0 free, 1 ball, 2 slide, 3 hinge
+    joints.set(name, { id: j, type, adr: model.jnt_qposadr[j], actuator: -1 });
+  }
+  for (let a = 0; a < model.nu; a++) {
+    const j = model.actuator_trnid[2 * a];
+    for (const joint of joints.values()) if (joint.id === j) joint.actuator = a;
+  }
+  return { id, joints };
+}
+
+function buildGeoms(mujoco, model, scene) {
+  const geoms = [];
+  for (let g = 0; g < model.ngeom; g++) {
+    const mesh = geomMesh(model, g);
+    if (!mesh) continue;
+    const collides = model.geom_contype[g] !== 0 || model.geom_conaffinity[g] !== 0;
+    const isFloor = model.geom_type[g] === 0;
+    mesh.userData = { g, collision: collides && !isFloor, body: model.geom_bodyid[g] };
+    mesh.visible = !mesh.userData.collision || isFloor;
+    mesh.matrixAutoUpdate = false;
+    scene.add(mesh);
+    geoms.push(mesh);
+  }
+  return geoms;
+}
+
+function placeGeoms(model, data, geoms) {
+  const pos = data.geom_xpos;
+  const mat = data.geom_xmat;
+  for (const mesh of geoms) {
+    const g = mesh.userData.g;
+    const m = mat.subarray(9 * g, 9 * g + 9);
+    mesh.matrix.set(m[0], m[1], m[2], pos[3 * g], m[3], m[4], m[5], pos[3 * g + 1],
+      m[6], m[7], m[8], pos[3 * g + 2], 0, 0, 0, 1);
+  }
+}
+
+function contactMarkers(scene, size) {
+  const material = new THREE.MeshBasicMaterial({ color: 0xff3050, depthTest: false });
+  const geometry = new THREE.SphereGeometry(size, 8, 6);
+  const markers = [];
+  for (let i = 0; i < MAX_CONTACTS; i++) {
+    const marker = new THREE.Mesh(geometry, material);
+    marker.visible = false;
+    marker.renderOrder = 3;
+    scene.add(marker);
+    markers.push(marker);
+  }
+  return markers;
+}
+
+function placeContacts(data, markers, on) {
+  const n = on ? Math.min(data.ncon, markers.length) : 0;
+  if (n) {
+    const contacts = data.contact;
+    for (let i = 0; i < n; i++) {
+      const c = contacts.get(i);
+      markers[i].position.set(c.pos[0], c.pos[1], c.pos[2]);
+      c.delete?.();
     }
-  });
-}
-
-// The extent on the canvas, in normalised device coordinates, of the visible vertices of
-// `object` in every pose of `poses` (each a list of joint values for `setPose`).
-function poseBox(camera, object, poses, setPose) {
-  const lo = [Infinity, Infinity];
-  const hi = [-Infinity, -Infinity];
-  camera.updateMatrixWorld(true);
-  for (const values of poses) {
-    setPose(values);
-    visibleVertices(object, (p) => {
-      p.project(camera);
-      lo[0] = Math.min(lo[0], p.x); lo[1] = Math.min(lo[1], p.y);
-      hi[0] = Math.max(hi[0], p.x); hi[1] = Math.max(hi[1], p.y);
-    });
+    contacts.delete();
   }
-  return { lo, hi };
-}
-
-// Frame the robot in every named pose (issue 25: with home alone, the flange left the canvas
-// in "stretched"): first a bounding sphere of the vertices of all poses, seen whole by the
-// narrower field of view; then a few steps that centre the poses' extent on the canvas and
-// move in until it fills FILL of the canvas in its longer direction.
-const FILL = 0.85;
-function frameCamera(view, object, poses, setPose) {
-  const { camera, controls } = view;
-  const box = new THREE.Box3();
-  for (const values of poses) {
-    setPose(values);
-    visibleVertices(object, (p) => box.expandByPoint(p));
-  }
-  if (box.isEmpty()) box.setFromObject(object);
-  const target = box.getCenter(new THREE.Vector3());
-  const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.05);
-  const halfV = THREE.MathUtils.degToRad(camera.fov / 2);
-  const halfH = Math.atan(Math.tan(halfV) * camera.aspect);
-  let distance = (1.05 * radius) / Math.sin(Math.min(halfV, halfH));
-  // from +x, -y (kit frame) and above; the kit's (x, y, z) is three's (x, z, -y)
-  const direction = new THREE.Vector3(1.2, 0.8, 1.6).normalize();
-  const place = () => {
-    camera.position.copy(target).addScaledVector(direction, distance);
-    camera.near = distance / 100;
-    camera.far = distance * 100;
-    camera.lookAt(target);
-    camera.updateProjectionMatrix();
-  };
-  place();
-  for (let step = 0; step < 6; step++) {
-    const { lo, hi } = poseBox(camera, object, poses, setPose);
-    const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
-    const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
-    target.addScaledVector(right, ((lo[0] + hi[0]) / 2) * Math.tan(halfH) * distance);
-    target.addScaledVector(up, ((lo[1] + hi[1]) / 2) * Math.tan(halfV) * distance);
-    const half = Math.max(hi[0] - lo[0], hi[1] - lo[1]) / 2;
-    distance *= Math.min(Math.max(half / FILL, 0.5), 2);
-    place();
-  }
-  for (let step = 0; step < 20; step++) { // never closer than the whole robot allows
-    const { lo, hi } = poseBox(camera, object, poses, setPose);
-    if (Math.min(...lo) >= -0.95 && Math.max(...hi) <= 0.95) break;
-    distance *= 1.1;
-    place();
-  }
-  controls.target.copy(target);
-  controls.update();
-  const grid = new THREE.GridHelper(radius * 4, 20, 0x5b6a7e, 0x3a4656);
-  grid.position.y = Math.min(box.min.y, 0);
-  view.scene.add(grid);
-}
-
-// The robot's extent on the canvas in normalised device coordinates ([-1, 1] is inside).
-function screenBox(view, object) {
-  const lo = [Infinity, Infinity];
-  const hi = [-Infinity, -Infinity];
-  view.camera.updateMatrixWorld(true);
-  visibleVertices(object, (p) => {
-    p.project(view.camera);
-    lo[0] = Math.min(lo[0], p.x); lo[1] = Math.min(lo[1], p.y);
-    hi[0] = Math.max(hi[0], p.x); hi[1] = Math.max(hi[1], p.y);
-  });
-  return { lo, hi };
-}
-
-function makeJoint(spec, model) {
-  const node = model.getObjectByName(spec.child);
-  if (!node) throw new Error(`joint ${spec.name}: no node ${spec.child} in the GLB`);
-  return {
-    name: spec.name,
-    type: spec.type,
-    lower: spec.lower ?? -Math.PI,
-    upper: spec.upper ?? Math.PI,
-    axis: new THREE.Vector3(...spec.axis).normalize(),
-    node,
-    q0: node.quaternion.clone(),
-    p0: node.position.clone(),
-  };
-}
-
-function applyJoint(joint, q) {
-  if (joint.type === 'prismatic') {
-    const shift = joint.axis.clone().applyQuaternion(joint.q0).multiplyScalar(q);
-    joint.node.position.copy(joint.p0).add(shift);
-  } else {
-    const turn = new THREE.Quaternion().setFromAxisAngle(joint.axis, q);
-    joint.node.quaternion.copy(joint.q0).multiply(turn);
-  }
-}
-
-function jointLabel(joint, q) {
-  return joint.type === 'prismatic'
-    ? `${(q * 1000).toFixed(1)} mm`
-    : `${THREE.MathUtils.radToDeg(q).toFixed(1)}°`;
-}
-
-function buildSliders(joints, start, render) {
-  const box = document.getElementById('joints');
-  const sliders = {};
-  joints.forEach((joint, i) => {
-    const value = element('span', { class: 'value' });
-    const input = element('input', {
-      type: 'range', min: joint.lower, max: joint.upper, step: 'any', 'data-joint': joint.name,
-    });
-    const set = (q) => {
-      applyJoint(joint, q);
-      value.textContent = jointLabel(joint, q);
-      render();
-    };
-    input.addEventListener('input', () => set(Number(input.value)));
-    const label = element('label', {}, joint.name);
-    label.appendChild(value);
-    const row = element('div', { class: 'joint' });
-    row.append(label, input);
-    box.appendChild(row);
-    sliders[joint.name] = { input, set };
-    input.value = start[i] ?? 0;
-    set(Number(input.value));
-  });
-  return sliders;
-}
-
-function buildPoses(robot, joints, sliders) {
-  const box = document.getElementById('poses');
-  const poses = robot.poses ?? (robot.home ? { home: robot.home } : {});
-  for (const [name, values] of Object.entries(poses)) {
-    const button = element('button', { 'data-pose': name }, name);
-    button.addEventListener('click', () => joints.forEach((joint, i) => {
-      sliders[joint.name].input.value = values[i] ?? 0;
-      sliders[joint.name].set(Number(sliders[joint.name].input.value));
-    }));
-    box.appendChild(button);
-  }
+  markers.forEach((m, i) => { m.visible = i < n; });
 }
 
 function toggle(container, label, attrs, checked, onChange) {
@@ -232,130 +160,202 @@ function toggle(container, label, attrs, checked, onChange) {
   return input;
 }
 
-function buildFrames(robot, model, size, render) {
-  const box = document.getElementById('frames');
-  const names = [robot.base_frame, robot.tool_frame].filter((n) => n && model.getObjectByName(n));
-  for (const name of [...new Set(names)]) {
-    const axes = new THREE.AxesHelper(size);
-    axes.name = `${name}_axes`;
-    axes.material.depthTest = false;
-    axes.renderOrder = 2;
-    model.getObjectByName(name).add(axes);
-    toggle(box, name, { 'data-frame': name }, true, (on) => { axes.visible = on; render(); });
-  }
-  if (!names.length) box.textContent = 'none named in robot.json';
+function jointLabel(joint, q) {
+  return joint.type === 'prismatic'
+    ? `${(q * 1000).toFixed(1)} mm`
+    : `${THREE.MathUtils.radToDeg(q).toFixed(1)}°`;
 }
 
-// A kit's OBJ collision piece (kitio/obj.py: `v x y z` and `f a b c` lines) as a geometry.
-async function loadObj(url) {
-  const text = await (await fetch(url)).text();
-  const vertices = [];
-  const corners = [];
-  for (const line of text.split('\n')) {
-    const parts = line.trim().split(/\s+/);
-    if (parts[0] === 'v') vertices.push(parts.slice(1, 4).map(Number));
-    if (parts[0] !== 'f') continue;
-    const ring = parts.slice(1).map((t) => {
-      const i = parseInt(t.split('/')[0], 10);
-      return i > 0 ? i - 1 : vertices.length + i;
-    });
-    for (let k = 1; k + 1 < ring.length; k++) corners.push(ring[0], ring[k], ring[k + 1]);
-  }
-  const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.Float32BufferAttribute(
-    corners.flatMap((i) => vertices[i]), 3));
-  geometry.computeVertexNormals();
-  return geometry;
+function panel(id) {
+  return document.getElementById(id) ?? element('div');
 }
 
-async function buildCollision(files, model, render) {
-  const box = document.getElementById('collision');
-  const byLink = new Map();
-  for (const path of files) {
-    const match = COLLISION_PIECE.exec(path);
-    if (match && model.getObjectByName(match[1])) {
-      if (!byLink.has(match[1])) byLink.set(match[1], []);
-      byLink.get(match[1]).push(path);
+class Sim {
+  constructor(mujoco, model, robot) {
+    this.mujoco = mujoco;
+    this.model = model;
+    this.data = new mujoco.MjData(model);
+    this.robot = robot;
+    this.index = indexModel(mujoco, model);
+    this.movable = robot.joints.filter((j) => j.type !== 'fixed');
+    this.poses = robot.poses ?? (robot.home ? { home: robot.home } : {});
+    this.paused = false;
+    this.sliders = {};
+  }
+
+  jointValues(values) {
+    return Object.fromEntries(this.movable.map((j, i) => [j.name, values[i] ?? 0]));
+  }
+
+  setTarget(name, value) {
+    const joint = this.index.joints.get(name);
+    if (!joint) throw new Error(`no joint ${name} in the MJCF`);
+    if (joint.actuator >= 0) this.data.ctrl[joint.actuator] = value;
+    const slider = this.sliders[name];
+    if (slider) slider.show(value);
+  }
+
+  // Drive the servos to a named pose (the joints move there under physics).
+  pose(name) {
+    const values = this.poses[name];
+    if (!values) throw new Error(`no named pose ${name}`);
+    for (const [joint, q] of Object.entries(this.jointValues(values))) this.setTarget(joint, q);
+  }
+
+  // Start over at a named pose (default: home): the model's initial state (a floating base
+  // where the MJCF puts it, above the floor), the joints at the pose, servos holding it.
+  reset(name) {
+    const values = this.poses[name ?? 'home'] ?? this.robot.home ?? [];
+    this.mujoco.mj_resetData(this.model, this.data);
+    for (const [joint, q] of Object.entries(this.jointValues(values))) {
+      const found = this.index.joints.get(joint);
+      if (found) this.data.qpos[found.adr] = q;
+      this.setTarget(joint, q);
     }
+    this.mujoco.mj_forward(this.model, this.data);
   }
-  if (!byLink.size) {
-    box.textContent = 'no collision meshes in this kit';
-    return 0;
+
+  // Place the bodies at joint values without stepping (for framing the camera).
+  showPose(values) {
+    for (const [joint, q] of Object.entries(this.jointValues(values))) {
+      const found = this.index.joints.get(joint);
+      if (found) this.data.qpos[found.adr] = q;
+    }
+    this.mujoco.mj_kinematics(this.model, this.data);
   }
-  const loader = new STLLoader();
-  const groups = [];
-  let count = 0;
-  for (const [link, paths] of byLink) {
-    const group = new THREE.Group();
-    group.name = `${link}_collision`;
-    group.visible = false;
-    const geometries = await Promise.all(paths.map((p) => (p.endsWith('.obj')
-      ? loadObj(`kit/${p}`) : loader.loadAsync(`kit/${p}`))));
-    geometries.forEach((geometry) => {
-      const material = new THREE.MeshStandardMaterial({
-        color: PALETTE[count++ % PALETTE.length], transparent: true, opacity: 0.55,
-        depthWrite: false, polygonOffset: true, polygonOffsetFactor: -2, polygonOffsetUnits: -2,
-      });
-      group.add(new THREE.Mesh(geometry, material));
+
+  step(n) {
+    for (let i = 0; i < n; i++) this.mujoco.mj_step(this.model, this.data);
+  }
+
+  qpos() {
+    const out = {};
+    for (const [name, joint] of this.index.joints) {
+      const width = joint.type === 0 ? 7 : joint.type === 1 ? 4 : 1;
+      const values = Array.from(this.data.qpos.subarray(joint.adr, joint.adr + width));
+      out[name] = width === 1 ? values[0] : values;
+    }
+    return out;
+  }
+
+  position(kind, name) {
+    const id = this.index.id(kind, name);
+    if (id < 0) return null;
+    const xyz = kind === 'mjOBJ_SITE' ? this.data.site_xpos : this.data.xpos;
+    return Array.from(xyz.subarray(3 * id, 3 * id + 3));
+  }
+}
+
+function buildControls(sim) {
+  const poses = panel('poses');
+  for (const name of Object.keys(sim.poses)) {
+    const button = element('button', { 'data-pose': name }, name);
+    button.addEventListener('click', () => sim.pose(name));
+    poses.appendChild(button);
+  }
+  const joints = panel('joints');
+  for (const joint of sim.movable) {
+    const value = element('span', { class: 'value' });
+    const input = element('input', {
+      type: 'range', min: joint.lower ?? -Math.PI, max: joint.upper ?? Math.PI, step: 'any',
+      'data-joint': joint.name,
     });
-    model.getObjectByName(link).add(group);
-    groups.push(group);
+    const label = element('label', {}, joint.name);
+    label.appendChild(value);
+    const row = element('div', { class: 'joint' });
+    row.append(label, input);
+    joints.appendChild(row);
+    sim.sliders[joint.name] = {
+      show: (q) => { input.value = q; value.textContent = jointLabel(joint, q); },
+    };
+    input.addEventListener('input', () => sim.setTarget(joint.name, Number(input.value)));
   }
-  const links = [];
-  toggle(box, 'all collision pieces', { 'data-collision': '*' }, false, (on) => {
-    links.forEach((input) => { input.checked = on; input.dispatchEvent(new Event('change')); });
+}
+
+function buildToggles(sim, geoms, markers, state) {
+  const box = panel('collision');
+  const pieces = geoms.filter((m) => m.userData.collision);
+  toggle(box, 'collision pieces', { 'data-collision': '*' }, false, (on) => {
+    pieces.forEach((m) => { m.visible = on; });
+    geoms.filter((m) => !m.userData.collision && m.geometry.type !== 'PlaneGeometry')
+      .forEach((m) => { m.material.transparent = on; m.material.opacity = on ? 0.35 : 1; });
   });
-  [...byLink.keys()].forEach((link, i) => {
-    links.push(toggle(box, `${link} (${byLink.get(link).length})`, { 'data-collision': link },
-      false, (on) => { groups[i].visible = on; render(); }));
-  });
-  return count;
+  toggle(box, 'contacts', { 'data-contacts': '*' }, false, (on) => { state.contacts = on; });
+  const sim_ = panel('simulation');
+  toggle(sim_, 'paused', { 'data-pause': '*' }, false, (on) => { sim.paused = on; });
+  const reset = element('button', { 'data-reset': '*' }, 'reset');
+  reset.addEventListener('click', () => sim.reset());
+  sim_.appendChild(reset);
+  return pieces.length;
 }
 
 async function main() {
-  const status = document.getElementById('status');
-  const robot = await fetchJson('kit/robot.json');
-  const files = await fetchJson('kit-files.json');
-  document.title = `simkit view: ${robot.name}`;
-  document.getElementById('title').textContent = robot.title ?? robot.name;
-  const view = setupScene(document.getElementById('view'));
-  const glb = robot.files?.glb ?? `glb/${robot.name}.glb`;
-  const gltf = await new GLTFLoader().loadAsync(`kit/${glb}`);
-  const model = gltf.scene;
-  view.scene.add(model);
-  const kitFrame = model.children[0];
-  const joints = robot.joints.filter((j) => j.type !== 'fixed').map((j) => makeJoint(j, model));
-  const start = robot.joints.filter((j) => j.type !== 'fixed').map((_, i) => (robot.home ?? [])[i]);
-  const sliders = buildSliders(joints, start, view.render);
-  buildPoses(robot, joints, sliders);
-  const setPose = (values) => joints.forEach((joint, i) => {
-    sliders[joint.name].input.value = values[i] ?? 0;
-    sliders[joint.name].set(Number(sliders[joint.name].input.value));
-  });
-  const poses = Object.values(robot.poses ?? {});
-  view.camera.aspect = view.aspect();
-  frameCamera(view, model, [...poses, start], setPose);
-  setPose(start);
-  const size = new THREE.Box3().setFromObject(model).getSize(new THREE.Vector3()).length();
-  buildFrames(robot, model, size / 10, view.render);
-  const pieces = await buildCollision(files, model, view.render);
-  api.screenBox = () => screenBox(view, model);
-  api.joints = joints.map(({ name, type, lower, upper }) => ({ name, type, lower, upper }));
-  api.framePosition = (name) => {
-    const node = model.getObjectByName(name);
-    model.updateMatrixWorld(true);
-    const relative = kitFrame.matrixWorld.clone().invert().multiply(node.matrixWorld);
-    return new THREE.Vector3().setFromMatrixPosition(relative).toArray();
-  };
+  const status = panel('status');
+  const source = await kitSource();
+  const robot = await (await fetchOk(`${source.base}robot.json`)).json();
+  panel('title').textContent = robot.title ?? robot.name;  // text, never markup
+  const mujoco = await loadMujoco();
+  const { model, main: mjcf } = await loadModel(mujoco, source, robot);
+  const sim = new Sim(mujoco, model, robot);
+  const view = setupScene(panel('view'));
+  const geoms = buildGeoms(mujoco, model, view.scene);
+  if (!geoms.some((m) => m.geometry.type === 'PlaneGeometry')) {  // no floor: a grid at z = 0
+    const grid = new THREE.GridHelper(4, 20, 0x5b6a7e, 0x3a4656);
+    grid.rotation.x = Math.PI / 2;
+    view.scene.add(grid);
+  }
+  buildControls(sim);
+  sim.reset();
+  const poses = [...Object.values(sim.poses), robot.home ?? []];
   view.resize();
-  status.textContent = `${glb}: ${joints.length} joints, ${pieces} collision pieces`;
-  api.ready = true;
+  const radius = frameCamera(view, geoms, poses, (values) => {
+    sim.showPose(values);
+    placeGeoms(model, sim.data, geoms);
+  });
+  sim.reset();
+  placeGeoms(model, sim.data, geoms);
+  const state = { contacts: false };
+  const markers = contactMarkers(view.scene, radius / 80);
+  const pieces = buildToggles(sim, geoms, markers, state);
+  const draw = () => {
+    placeGeoms(model, sim.data, geoms);
+    placeContacts(sim.data, markers, state.contacts);
+    view.render();
+  };
+  let wall = null;
+  const frame = (now) => {
+    if (wall !== null && !sim.paused) {
+      const goal = sim.data.time + Math.min((now - wall) / 1000, 0.1);
+      for (let i = 0; i < MAX_STEPS_PER_FRAME && sim.data.time < goal; i++) sim.step(1);
+      if (api.firstFrame === null && sim.data.time > 0) api.firstFrame = performance.now();
+    }
+    wall = now;
+    draw();
+    requestAnimationFrame(frame);
+  };
+  Object.assign(api, {
+    time: () => sim.data.time,
+    qpos: () => sim.qpos(),
+    setTarget: (joint, value) => sim.setTarget(joint, value),
+    pose: (name) => sim.pose(name),
+    reset: (name) => { sim.reset(name); draw(); },
+    pause: (on = true) => { sim.paused = on; },
+    step: (n = 1) => { sim.step(n); draw(); return sim.data.time; },
+    bodyPosition: (name) => sim.position('mjOBJ_BODY', name),
+    framePosition: (name) => sim.position('mjOBJ_SITE', name) ?? sim.position('mjOBJ_BODY', name),
+    timestep: () => model.opt.timestep,
+    screenBox: () => screenBox(view.camera, geoms),
+  });
+  status.textContent = `${mjcf}: ${sim.movable.length} joints, ${pieces} collision pieces`;
+  requestAnimationFrame(frame);
+  settle.ok(api);
 }
 
 main().catch((error) => {
-  const status = document.getElementById('status');
+  const status = panel('status');
   status.textContent = `error: ${error.message ?? error}`;
   status.className = 'error';
   api.error = String(error.message ?? error);
   console.error(error);
+  settle.no(error);
 });
