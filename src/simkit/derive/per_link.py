@@ -47,7 +47,7 @@ def default_jobs() -> int:
 def _solid_key(link: Link, base_dir: Path) -> str:
     from dataclasses import asdict
 
-    from simkit.derive.solids import CIRCULAR_SEGMENTS, SPHERE_SEGMENTS
+    from simkit.derive.solids import CIRCULAR_SEGMENTS, PARTS_RULE, SPHERE_SEGMENTS
 
     inputs = []
     for shape in link.shapes:
@@ -62,6 +62,8 @@ def _solid_key(link: Link, base_dir: Path) -> str:
         "segments": CIRCULAR_SEGMENTS,
         "sphere_segments": SPHERE_SEGMENTS,
     }
+    if inputs:  # a mesh file's parts are united (solids.py): primitive links keep their keys
+        params["mesh_parts"] = PARTS_RULE
     return make_key(SOLID_STEP, SOLID_VERSION, inputs, params, libraries)
 
 

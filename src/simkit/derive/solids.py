@@ -2,6 +2,13 @@
 
 Union first (in spec order), then subtract the `subtract: true` primitives. Round shapes
 use a fixed segment count so output is deterministic.
+
+A mesh file of several closed parts (a glTF or CAD scene flattened to one mesh, issue 42
+classes 5 and 10) is the union of its parts: manifold3d takes overlapping parts as they
+come, so the mesh counted an overlap twice and an inside-out part (glTF's double-sided
+materials hide winding) as negative volume, and the visual STL, the STEP solid and the mass
+disagreed about what the solid is (a STEP 143 % off its STL). A part facing inward that lies
+inside an outward part is that part's cavity and stays one; any other is turned outward.
 """
 
 from __future__ import annotations
@@ -46,7 +53,68 @@ def _load_mesh(shape: Shape, base_dir: Path) -> mf.Manifold:
     solid = mf.Manifold(mf.Mesh(vert_properties=verts, tri_verts=faces))
     if solid.status() != mf.Error.NoError or solid.is_empty():
         raise SpecError(str(path), None, "solid.file", "mesh is not a closed, manifold solid")
-    return solid
+    return union_of_parts(solid)
+
+
+#: relative: parts whose union holds their summed volume to this are disjoint (kept as read)
+DISJOINT_SLACK = 1e-9
+#: bumped when `union_of_parts` changes what a mesh file's solid is (per_link.py's cache key)
+PARTS_RULE = 1
+
+
+def _turned(part: mf.Manifold) -> mf.Manifold:
+    """`part` with its triangles wound the other way (an inside-out part turned outward)."""
+    out = part.to_mesh64()
+    faces = np.array(np.asarray(out.tri_verts)[:, ::-1], np.uint64, order="C")  # writable copies
+    verts = np.array(np.asarray(out.vert_properties)[:, :3], np.float64, order="C")
+    return mf.Manifold(mf.Mesh64(vert_properties=verts, tri_verts=faces))
+
+
+def union_of_parts(solid: mf.Manifold) -> mf.Manifold:
+    """The region a mesh of closed parts encloses (module doc): each outward part less the
+    inward parts it wholly holds (its cavities), united with every other part turned
+    outward. A mesh of one outward part, or of disjoint parts with no stray inward one, is
+    returned as read (the same bytes as before)."""
+    parts = solid.decompose()
+    if len(parts) < 2 and solid.volume() > 0:
+        return solid
+    outward = [p for p in parts if p.volume() > 0]
+    hosted: dict[int, list[mf.Manifold]] = {}
+    stray = []
+    for part in (p for p in parts if p.volume() <= 0):
+        cavity = _turned(part)
+        host = next((i for i, o in enumerate(outward) if _holds(o, cavity)), None)
+        if host is None:
+            stray.append(cavity)
+        else:
+            hosted.setdefault(host, []).append(cavity)
+    if not stray and _disjoint(outward):
+        return solid
+    pieces = [
+        o - mf.Manifold.batch_boolean(hosted[i], mf.OpType.Add) if i in hosted else o
+        for i, o in enumerate(outward)
+    ]
+    pieces += stray
+    return mf.Manifold.batch_boolean(pieces, mf.OpType.Add) if len(pieces) > 1 else pieces[0]
+
+
+def _holds(outer: mf.Manifold, inner: mf.Manifold) -> bool:
+    """True when `outer` holds all of `inner` (both outward); boxes first, so a mesh of
+    many parts pays a Boolean only for the pairs whose boxes nest."""
+    low, high = np.split(np.asarray(outer.bounding_box()), 2)
+    in_low, in_high = np.split(np.asarray(inner.bounding_box()), 2)
+    if np.any(in_low < low) or np.any(in_high > high):
+        return False
+    return (outer ^ inner).volume() >= inner.volume() * (1.0 - 1e-6)
+
+
+def _disjoint(parts: list[mf.Manifold]) -> bool:
+    """True when the parts' union holds their summed volume: no two overlap."""
+    if len(parts) < 2:
+        return True
+    total = sum(p.volume() for p in parts)
+    union = mf.Manifold.batch_boolean(parts, mf.OpType.Add).volume()
+    return abs(union / total - 1.0) <= DISJOINT_SLACK
 
 
 def primitive_solid(shape: Shape, base_dir: Path | None = None) -> mf.Manifold:
