@@ -137,4 +137,4 @@ def test_a_large_humanoid_builds_and_says_which_gpu_scene_it_has(tmp_path):
     assert gpu.ngeom > 100 and gpu.npair == block["pairs"] <= 512
     mujoco.mj_step(gpu, mujoco.MjData(gpu))
     assert gpu.nconmax == -1 and gpu.njmax == -1  # Warp's sizes are custom numerics
-    assert f"`nconmax` {block['nconmax']}" in readme
+    assert f"`warp_nconmax` {block['nconmax']}" in readme

@@ -15,15 +15,25 @@ import pytest
 
 from simkit.check.gpu_scene import check_gpu_scene, held_positions
 from simkit.check.kit import Kit
-from simkit.derive.gpu_solver import CANDIDATES, HOLD_MARGIN, hold_errors
+from simkit.derive.gpu_solver import (
+    CANDIDATES,
+    HOLD_MARGIN,
+    converged_iterations,
+    hold_errors,
+)
 from simkit.pipeline import model_from_spec
 
 
-def test_the_solver_is_the_cheapest_candidate_that_holds():
+def test_the_solver_is_the_cheapest_converged_candidate_that_holds():
+    """Asimov standing needs 3 Newton iterations in some steps: fewer hold it in C MuJoCo
+    (0.6 mm at 1 / 1) but leave MJX 13 mm from C MuJoCo after 100 steps, so 3 / 6."""
     robot = model_from_spec("asimov")
     plan = robot.products.gpu_scene
-    index = CANDIDATES.index((plan["iterations"], plan["ls_iterations"]))
-    errors = hold_errors(robot, plan, CANDIDATES[: index + 1])
+    least = converged_iterations(robot, plan)
+    eligible = [c for c in CANDIDATES if c[0] >= least]
+    index = eligible.index((plan["iterations"], plan["ls_iterations"]))
+    errors = hold_errors(robot, plan, eligible[: index + 1])
+    assert least > 1 and plan["iterations"] >= least
     assert all(error > HOLD_MARGIN for error in errors[:-1]), errors
     assert errors[-1] <= HOLD_MARGIN and errors[-1] == pytest.approx(plan["hold"], abs=1e-6)
 

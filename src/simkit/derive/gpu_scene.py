@@ -111,8 +111,9 @@ METHOD = (
     "(pairs within 5 mm), raised until broadphase_draws.run configurations in a row drawn "
     "within the limits have no touching pair ranked beyond it; broadphase_rank: the worst rank "
     "of a touching pair in the first samples; solver: the fewest iterations / ls_iterations "
-    "(cheapest first of 1/1, 1/2, 2/2, 2/4, 3/6, 4/8, 8/16, 16/32) for which the servos hold every "
-    "named pose for 2 s in C MuJoCo with the scene's pairs within 2.5 mm of every contact at "
+    "(cheapest first of 1/2, 2/4, 3/6, 4/8, 6/12, 8/16, 16/32), at least the most MuJoCo's "
+    "solver takes to converge in a step of the holds, for which the servos hold every named "
+    "pose for 2 s in C MuJoCo with the scene's pairs within 2.5 mm of every contact at "
     "MuJoCo's default solver; hold_error_m: that distance"
 )
 #: the confidence robot.json states for max_geom_pairs (the rule of three, 95 %)
