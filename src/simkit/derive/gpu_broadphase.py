@@ -160,8 +160,8 @@ def max_geom_pairs(
 ) -> dict:
     """`max_geom_pairs` for `pairs` of `mjx_pairs`: k (None: no cull), the worst rank seen in
     `rows` (sampled-joint order), the confirming draw's size (`confirm`) and the sampled
-    maximum it started from (`sampled`). `colliders`
-    holds every geom the pairs name, stand-in boxes included."""
+    maximum it started from (`sampled`). `colliders` holds every geom the pairs name,
+    stand-in boxes included."""
     scene = _scene(robot, colliders, pairs)
     crowd = worst = 0
     for _, most, rank in _seen(scene, robot, rows, depth):

@@ -24,7 +24,7 @@ def capped_pairs(
         return pairs, None
     seen = Counter(p for _, touching in contacts for p in touching)
     ranked = sorted(pairs, key=lambda p: (tuple(p) not in named, -seen[tuple(p)], p))
-    kept = sorted(ranked[: max(room, sum(1 for p in pairs if tuple(p) in named))])
+    kept = sorted(ranked[: max(room, 0, sum(1 for p in pairs if tuple(p) in named))])
     note = (
         f"self-collision cut to {len(kept)} of {len(pairs)} pairs in the GPU scene (those in "
         "contact at a named pose, then the most often in contact in the samples): the main "
