@@ -152,10 +152,23 @@ def mjx_rate(path: Path, worlds: int, steps: int) -> dict:
     }
 
 
+def numeric(model, name: str) -> int | None:
+    """The model's custom numeric `name`, or None."""
+    import mujoco
+
+    index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name)
+    return None if index < 0 else int(model.numeric_data[model.numeric_adr[index]])
+
+
 def warp_sizes(model) -> dict[str, int]:
-    """The file's own `<size nconmax njmax>` for MuJoCo Warp (contacts and constraint rows per
-    world); Warp's defaults where the file sets none."""
-    return {k: int(getattr(model, k)) for k in ("nconmax", "njmax") if getattr(model, k) >= 0}
+    """The file's own sizes for MuJoCo Warp (contacts and constraint rows per world): the
+    custom numerics `warp_nconmax` / `warp_njmax` (a GPU scene writes them there so that C
+    MuJoCo sizes its own arena), else `<size nconmax njmax>`; Warp's defaults where neither."""
+    out = {k: numeric(model, f"warp_{k}") for k in ("nconmax", "njmax")}
+    for k in out:
+        if out[k] is None and getattr(model, k) >= 0:
+            out[k] = int(getattr(model, k))
+    return {k: v for k, v in out.items() if v is not None}
 
 
 def warp_rate(path: Path, worlds: int, steps: int) -> dict | None:
@@ -208,7 +221,7 @@ def warp_probe(kit: Path, steps: int = 10) -> dict:
         "device": str(wp.get_device()),
         "nan": bool(np.isnan(d.qpos.numpy()).any()),
         "nefc": int(d.nefc.numpy().max()),
-        "njmax": int(model.njmax),
+        "njmax": warp_sizes(model)["njmax"],
     }
 
 

@@ -1,7 +1,9 @@
-"""How crowded a GPU scene's MJX pair groups get (issue 30): over seeded configurations that
-only touch, the worst rank of a touching pair within its group by bounding-sphere distance,
-and the most pairs of one group whose bounding spheres come within 5 mm (the bound
-`max_geom_pairs` is derived from). One JSON line per kit and seed.
+"""How crowded a GPU scene's MJX pair groups get (issues 30, 42): over seeded configurations
+that only touch, the worst rank of a touching pair within its group by bounding-sphere
+distance, and the most pairs of one group whose bounding spheres come within 5 mm (where
+`max_geom_pairs` starts); `misses`: configurations with a touching pair ranked beyond the
+file's `max_geom_pairs`, against `allowed`, what the check allows that many draws under the
+stated bound (3 in 20,000). One JSON line per kit and seed.
 
     python scripts/broadphase_ranks.py KIT... [--samples 20000] [--seeds 11 12 13]
 """
@@ -50,6 +52,7 @@ def survey(path: Path, samples: int, seed: int) -> dict:
         if touching:
             ranks.append(bp.ranks(data, model.geom_rbound, groups, touching))
             crowds.append(crowding(model, data, groups))
+    cull = bp.numeric(model, "max_geom_pairs")
     return {
         "file": path.name,
         "seed": seed,
@@ -57,7 +60,9 @@ def survey(path: Path, samples: int, seed: int) -> dict:
         "worst_rank": max(ranks, default=0),
         "rank_p99": float(np.percentile(ranks, 99)) if ranks else 0.0,
         "most_crowded": max(crowds, default=0),
-        "max_geom_pairs": bp.numeric(model, "max_geom_pairs"),
+        "max_geom_pairs": cull,
+        "misses": sum(r > cull for r in ranks) if cull is not None else 0,
+        "allowed": bp.allowed_misses(samples + model.nkey),
     }
 
 

@@ -1,12 +1,18 @@
-"""The GPU scene's MJX broad phase keeps every pair that touches (issue 30).
+"""The GPU scene's MJX broad phase keeps the pairs that touch (issues 30, 42).
 
 MJX's custom numeric `max_geom_pairs` = k keeps, in each group of pairs with the same two geom
 types, the k pairs whose bounding spheres are nearest, and never narrow-phases the rest. This
 check reads the written GPU scene, draws its own seeded configurations within the joint limits
 (followers of joint equalities placed by their polynomial; a floating base where keyframe 0
 puts it), and in each configuration that only touches (no pair deeper than `DEPTH`) requires
-every pair in contact to rank within k of its group. The derive step chose k from other
-samples (the SRDF's); this is an independent draw of the same space.
+each pair in contact to rank within k of its group. The derive step chose k so that a
+configuration drawn within the limits has a touching pair beyond k with probability under
+3 / 20,000 at 95 % confidence (robot.json `gpu_scene.broadphase_draws`: 20,000 draws in a row
+without one; issue 42, class 2). This draw is independent of the derive's: it counts its
+configurations with such a miss and fails where more are seen than that bound allows (the
+binomial tail beyond `ALPHA`). At the bound, 20,000 draws expect 3 misses and allow 10; a k
+of 1 on a 7-axis arm of mesh hulls, whose configurations touch in 3 of 1,000, misses in about
+18 and fails. (2,000 draws, the first size, allowed 3 and let that k pass.)
 """
 
 from __future__ import annotations
@@ -16,8 +22,8 @@ import numpy as np
 from simkit.check.findings import Finding, compare, require
 
 CHECK = "gpu_scene"
-#: seeded configurations drawn, and the draw's seed
-SAMPLES = 2000
+#: seeded configurations drawn, and the draw's seed (20,000: under a second for each seed kit)
+SAMPLES = 20_000
 SEED = 30
 #: m: a configuration with a pair deeper than this is one a servo never reaches; pairs closer
 #: than `NEAR` count as in contact (a touch lies between two draws)
@@ -25,6 +31,11 @@ DEPTH = 0.005
 NEAR = 0.005
 #: rad, m: the draw's range for a joint without limits
 UNLIMITED = np.pi
+#: the miss probability a written k holds to (derive/gpu_broadphase.py's 3 / RUN: the kit
+#: states it, the check holds every kit to the same figure rather than to the kit's word)
+MISS_BOUND = 3 / 20_000
+#: the chance that a k that meets the bound fails the check anyway
+ALPHA = 1e-3
 
 
 def numeric(model, name: str) -> int | None:
@@ -89,12 +100,14 @@ def ranks(data, rbound: np.ndarray, groups: list, touching: set[int]) -> int:
     return worst
 
 
-def worst_rank(model, samples: int = SAMPLES, seed: int = SEED) -> int:
-    """The worst rank of a pair in contact over the keyframes and the seeded draw."""
+def misses(model, samples: int = SAMPLES, seed: int = SEED) -> tuple[int, int, int]:
+    """(configurations with a touching pair ranked beyond max_geom_pairs, the worst rank of a
+    touching pair, configurations that only touch) over the keyframes and the seeded draw."""
     import copy
 
     import mujoco
 
+    cull = numeric(model, "max_geom_pairs")
     model = copy.deepcopy(model)
     model.pair_margin[:] = NEAR
     data = mujoco.MjData(model)
@@ -104,7 +117,7 @@ def worst_rank(model, samples: int = SAMPLES, seed: int = SEED) -> int:
         for members, _ in groups
         for i in members
     }
-    worst = 0
+    missed = worst = touched = 0
     for row in configurations(model, samples, seed) if index else []:
         data.qpos[:] = row
         mujoco.mj_kinematics(model, data)
@@ -115,12 +128,23 @@ def worst_rank(model, samples: int = SAMPLES, seed: int = SEED) -> int:
         touching = {index.get(frozenset(int(g) for g in pair)) for pair in contacts.geom}
         touching.discard(None)
         if touching:
-            worst = max(worst, ranks(data, model.geom_rbound, groups, touching))  # type: ignore[arg-type]
-    return worst
+            rank = ranks(data, model.geom_rbound, groups, touching)  # type: ignore[arg-type]
+            worst, touched = max(worst, rank), touched + 1
+            missed += cull is not None and rank > cull
+    return missed, worst, touched
+
+
+def allowed_misses(draws: int, bound: float = MISS_BOUND, alpha: float = ALPHA) -> int:
+    """The most misses `draws` configurations show with probability over 1 - `alpha` when each
+    misses with probability `bound` (the binomial quantile)."""
+    from scipy.stats import binom
+
+    return int(binom.ppf(1.0 - alpha, draws, bound))
 
 
 def check_broadphase(gpu, doc: dict) -> list[Finding]:
-    """`max_geom_pairs` is robot.json's, and keeps every pair the draw finds in contact."""
+    """`max_geom_pairs` is robot.json's, and keeps the pairs the draw finds in contact within
+    the bound it was derived to (`MISS_BOUND`)."""
     stated = (doc.get("gpu_scene") or {}).get("max_geom_pairs")
     cull = numeric(gpu, "max_geom_pairs")
     out = [
@@ -135,9 +159,12 @@ def check_broadphase(gpu, doc: dict) -> list[Finding]:
     ]
     if cull is None:
         return out
-    worst = worst_rank(gpu)
+    missed, worst, touched = misses(gpu)
+    draws = SAMPLES + gpu.nkey
+    allowed = allowed_misses(draws)
     message = (
-        f"MJX's broad phase keeps every pair in contact: worst rank {worst} of max_geom_pairs "
-        f"{cull} over the keyframes and {SAMPLES} seeded configurations that only touch"
+        f"MJX's broad phase keeps the pairs in contact: {missed} of {draws} configurations "
+        f"({touched} only touch) have a touching pair beyond max_geom_pairs {cull} (worst rank "
+        f"{worst}); at most {allowed} under a miss probability of {MISS_BOUND:.2g}"
     )
-    return [*out, require(CHECK, worst <= cull, message)]
+    return [*out, require(CHECK, missed <= allowed, message)]

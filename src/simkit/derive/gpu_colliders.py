@@ -83,14 +83,19 @@ def _text(values) -> str:
     return " ".join(repr(float(v)) for v in np.ravel(values))
 
 
-def _scratch_geom(robot: Robot, asset: ET.Element, body: ET.Element, geom: dict) -> None:
+def scratch_geom(
+    robot: Robot, asset: ET.Element, body: ET.Element, geom: dict, own_cap: bool = False
+) -> None:
+    """A collider in a scratch model; a piece's hull capped at `MAX_HULL_VERTICES`, or with
+    `own_cap` at the plan's `maxhullvert` (as the GPU scene writes it)."""
     attrs = {"name": geom["name"]}
     kind = geom["kind"]
     if kind == "piece":
         vertices = piece_vertices(robot, geom)
         mesh = {"name": geom["name"], "vertex": _text(vertices)}
-        if len(vertices) > MAX_HULL_VERTICES:
-            mesh["maxhullvert"] = str(MAX_HULL_VERTICES)
+        cap = geom.get("maxhullvert") if own_cap else MAX_HULL_VERTICES
+        if cap is not None and len(vertices) > cap:
+            mesh["maxhullvert"] = str(cap)
         ET.SubElement(asset, "mesh", mesh)
         attrs.update(type="mesh", mesh=geom["name"])
     else:
@@ -126,7 +131,7 @@ def scratch_xml(
     for joint in robot.joints:
         body = bodies[joint.child] = scratch_body(bodies[joint.parent], joint)
         for geom in by_link.get(joint.child, []):
-            _scratch_geom(robot, asset, body, geom)
+            scratch_geom(robot, asset, body, geom)
     contact = ET.SubElement(root, "contact")
     for a, b in sorted(skip):
         ET.SubElement(contact, "exclude", body1=a, body2=b)

@@ -33,7 +33,8 @@ from dataclasses import replace
 import numpy as np
 
 from simkit.derive.collision_pairs import configurations, sampled_joints
-from simkit.derive.gpu_broadphase import max_geom_pairs, mjx_pairs
+from simkit.derive.gpu_broadphase import RUN, max_geom_pairs, mjx_pairs
+from simkit.derive.gpu_budget import capped_pairs, no_scene
 from simkit.derive.gpu_colliders import (
     MAX_HULL_VERTICES,
     colliders,
@@ -43,16 +44,10 @@ from simkit.derive.gpu_colliders import (
     sampled_contacts,
     scratch_xml,
 )
+from simkit.derive.gpu_solver import HOLD_TOLERANCE, fewest_iterations
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Robot
 
-#: solver settings for batched simulation: Newton with few iterations (the issue's measured
-#: Asimov variant). Fewer are faster for a robot on its feet (on an H200, Asimov's scene ran
-#: 1.48x faster at 1 / 4), but an imported quadruped then held its stance up to
-#: 82 mm away from the main MJCF's at 2 / 4 and 37 mm at 2 / 8, over the check's 5 mm
-#: (docs/gpu.md); the arms run alike at any of these settings
-ITERATIONS = 4
-LS_ITERATIONS = 8
 #: contact slots a pair takes in MJX (mujoco-mjx 3.17 collision functions' `ncon`), by the
 #: two MuJoCo geom types in MuJoCo's order; `mesh` stands for pieces
 MJX_CONTACTS = {
@@ -78,6 +73,13 @@ MJX_CONTACTS = {
 TYPE_ORDER = ("plane", "sphere", "capsule", "cylinder", "box", "mesh")
 #: a target for contact slots per world; a robot over it says so in one line (robot.json)
 SLOT_TARGET = 64
+#: the most explicit pairs (floor pairs included) a GPU scene carries. Asimov's 161 is the
+#: largest seed scene (0.41-0.46x MJX's humanoid on an H200), a 7-axis arm of dense collision
+#: spheres has about 450; an imported 74-joint humanoid's 1,489 self pairs asked for 5,956
+#: contact slots a world, which no batch of thousands holds.
+#: Over it, the self pairs are cut to those in contact at a named pose plus the ones most
+#: often in contact in the samples, and robot.json says so in one line (issue 42, class 9)
+MAX_PAIRS = 512
 #: constraint rows per contact: condim 3 in a pyramidal cone (MuJoCo's defaults)
 ROWS_PER_CONTACT = 4
 #: the floor's name in pairs when the spec names none
@@ -102,10 +104,22 @@ METHOD = (
     "contact_slots: MJX slots of the floor pairs plus twice the most in use at once in a "
     f"sampled configuration that penetrates under {TOUCHING_DEPTH} m (MJX max_contact_points "
     f"keeps the deepest), at most pair_slots; njmax: {ROWS_PER_CONTACT} rows a contact plus "
-    "joint limits, friction loss and mimics; max_geom_pairs (MJX's broad phase, absent: no "
-    "cull): the most pairs of one MJX group whose bounding spheres come within 5 mm in a named "
-    "pose or a sampled configuration that only touches (pairs within 5 mm); broadphase_rank: "
-    "the worst rank of a touching pair seen there"
+    "joint limits, friction loss and mimics (MuJoCo Warp's sizes, custom numerics "
+    "warp_nconmax and warp_njmax, so C MuJoCo and MJX size their own arena); max_geom_pairs "
+    "(MJX's broad phase, absent: no cull): the most pairs of one MJX group whose bounding "
+    "spheres come within 5 mm in a named pose or a sampled configuration that only touches "
+    "(pairs within 5 mm), raised until broadphase_draws.run configurations in a row drawn "
+    "within the limits have no touching pair ranked beyond it; broadphase_rank: the worst rank "
+    "of a touching pair in the first samples; solver: the fewest iterations / ls_iterations "
+    "(cheapest first of 1/2, 2/4, 3/6, 4/8, 6/12, 8/16, 16/32), at least the most MuJoCo's "
+    "solver takes to converge in a step of the holds, for which the servos hold every named "
+    "pose for 2 s in C MuJoCo with the scene's pairs within 2.5 mm of every contact at "
+    "MuJoCo's default solver; hold_error_m: that distance"
+)
+#: the confidence robot.json states for max_geom_pairs (the rule of three, 95 %)
+CONFIDENCE = (
+    "a configuration drawn within the joint limits has a touching pair ranked beyond "
+    "max_geom_pairs with probability under 3 / run (95 % confidence, the rule of three)"
 )
 
 
@@ -272,20 +286,8 @@ def constraint_rows(robot: Robot, contacts: int) -> int:
     return ROWS_PER_CONTACT * contacts + limited + friction + mimics
 
 
-def derive_gpu_scene(robot: Robot) -> Robot:
-    """`products.gpu_scene`: colliders, contact pairs, floor pairs and the contact budget.
-
-    Slots per world are capped (MJX's `max_contact_points`, the deepest kept) at the floor
-    pairs all at once (standing) plus twice the most slots self-contact needs at once in a
-    sampled configuration that only touches (`peak_slots`)."""
-    geoms = [g for link in robot.links for g in colliders(link)]
-    q = configurations(robot, robot.seed)
-    # the named poses too: a pair in contact where the servos hold the robot must collide
-    rows = np.vstack([_named_rows(robot), q])
-    contacts = sampled_contacts(robot, geoms, rows)
-    pairs = sorted([a, b] for a, b in set().union(*(c for _, c in contacts)))
-    floating = robot.floating_joint is not None
-    floor = floor_colliders(geoms) if floating else []
+def _colliders_for(robot: Robot, geoms: list[dict], pairs: list, floating: bool) -> dict:
+    """Stand-in boxes and hull caps on `geoms` (in place); the cylinders' swaps."""
     standing = standing_colliders(robot, geoms) if floating else set()
     kinds = {g["name"]: g["kind"] for g in geoms}
     swaps = stand_ins(kinds, pairs)
@@ -300,9 +302,50 @@ def derive_gpu_scene(robot: Robot) -> Robot:
     for geom in geoms:
         if geom["name"] in inscribed:
             geom["box_half"] = geom["radius"] / math.sqrt(2)
+    return swaps
+
+
+def _draws_block(cull: dict) -> dict | None:
+    """robot.json's statement of how far `max_geom_pairs` holds (None: no cull)."""
+    if cull["k"] is None:
+        return None
+    bound = round(3.0 / RUN, 6)
+    return {
+        "run": RUN,
+        "drawn": cull["drawn"],
+        "sampled_k": cull["sampled"],
+        "miss_below": bound,
+        "confidence": CONFIDENCE,
+    }
+
+
+def plan_gpu_scene(robot: Robot) -> dict:
+    """The GPU scene's plan: colliders, contact pairs, floor pairs and the contact budget.
+
+    Slots per world are capped (MJX's `max_contact_points`, the deepest kept) at the floor
+    pairs all at once (standing) plus twice the most slots self-contact needs at once in a
+    sampled configuration that only touches (`peak_slots`)."""
+    geoms = [g for link in robot.links for g in colliders(link)]
+    q = configurations(robot, robot.seed)
+    # the named poses too: a pair in contact where the servos hold the robot must collide
+    named = _named_rows(robot)
+    contacts = sampled_contacts(robot, geoms, np.vstack([named, q]))
+    pairs = sorted([a, b] for a, b in set().union(*(c for _, c in contacts)))
+    floating = robot.floating_joint is not None
+    floor = floor_colliders(geoms) if floating else []
+    held = set().union(*(c for _, c in sampled_contacts(robot, geoms, named)))
+    pairs, cut = capped_pairs(pairs, held, contacts, MAX_PAIRS - len(floor))
+    kept = {tuple(p) for p in pairs}
+    contacts = [(d, c & kept) for d, c in contacts if c & kept]
+    swaps = _colliders_for(robot, geoms, pairs, floating)
+    kinds = {g["name"]: g["kind"] for g in geoms}
     boxes = [stand_in_box(g, g["box_half"]) for g in geoms if g["name"] in swaps]
-    cull, rank = max_geom_pairs(
-        robot, geoms + boxes, mjx_pairs(pairs, kinds, swaps), rows, TOUCHING_DEPTH
+    cull = max_geom_pairs(
+        robot,
+        geoms + boxes,
+        mjx_pairs(pairs, kinds, swaps),
+        np.vstack([named, q]),
+        TOUCHING_DEPTH,
     )
     standing = sum(pair_slots(kinds, FLOOR, g) for g in floor)
     every = standing + sum(pair_slots(kinds, a, b, swaps) for a, b in pairs)
@@ -315,20 +358,40 @@ def derive_gpu_scene(robot: Robot) -> Robot:
         "pair_slots": every,
         "touching_peak": peak,
         "contact_slots": budget,
-        "max_geom_pairs": cull,
-        "broadphase_rank": rank,
+        "max_geom_pairs": cull["k"],
+        "broadphase_rank": cull["rank"],
+        "broadphase_draws": _draws_block(cull),
         "nconmax": max(budget, 1),
         "njmax": max(constraint_rows(robot, budget), 1),
-        "iterations": ITERATIONS,
-        "ls_iterations": LS_ITERATIONS,
         "method": METHOD,
         "seed": robot.seed,
         "samples": len(q),
     }
+    (block["iterations"], block["ls_iterations"]), hold = fewest_iterations(robot, block)
+    block["hold"] = round(hold, 6)  # m; micrometres: the figure, not the platform's last bits
+    notes = [cut] if cut else []
     if budget > SLOT_TARGET:
-        block["note"] = (
+        notes.append(
             f"the GPU scene needs {budget} contact slots per world, over the {SLOT_TARGET} "
             "simkit aims for: the source's collision geometry touches in that many places"
+        )
+    if notes:
+        block["note"] = "; ".join(notes)
+    return block
+
+
+def derive_gpu_scene(robot: Robot) -> Robot:
+    """`products.gpu_scene`: the plan (`plan_gpu_scene`), or one line saying why the kit has
+    no GPU scene where MuJoCo cannot compile the colliders (a GPU scene never fails a build)."""
+    try:
+        block = plan_gpu_scene(robot)
+    except ValueError as exc:  # MuJoCo's compiler: e.g. a collision piece it cannot hull
+        block = no_scene(f"MuJoCo cannot compile its colliders ({str(exc).splitlines()[0]})")
+    if block.get("hold", 0.0) > HOLD_TOLERANCE:
+        block = no_scene(
+            f"held at its named poses with the GPU scene's pairs it ends {block['hold'] * 1e3:.1f} "
+            f"mm from where every contact puts it, even at solver iterations {block['iterations']}"
+            f" / {block['ls_iterations']} (the gpu_scene check allows {HOLD_TOLERANCE * 1e3:g} mm)"
         )
     seeds = {**robot.products.seeds, "gpu_scene": robot.seed}
     return replace(robot, products=replace(robot.products, gpu_scene=block, seeds=seeds))

@@ -95,13 +95,16 @@ def _gpu(robot: Robot) -> dict:
     """Values for the README's GPU section (robot.json `gpu_scene`)."""
     block = robot_json.gpu_scene(robot)
     if block is None:
-        return {"gpu": None}
+        return {"gpu": None, "gpu_none": None}
+    if block["file"] is None:  # no GPU scene: the one line saying why
+        return {"gpu": None, "gpu_none": block["note"]}
     return {
         "gpu": {
             **block,
             "floor_pairs": len(block["floor_pairs"]),
             "self_pairs": block["pairs"] - len(block["floor_pairs"]),
-        }
+        },
+        "gpu_none": None,
     }
 
 

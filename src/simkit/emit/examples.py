@@ -42,8 +42,10 @@ def emit(robot: Robot) -> dict[str, bytes]:
     """`examples/mujoco_demo.py`, `examples/pybullet_demo.py` and, with a GPU scene,
     `examples/mjx_demo.py`."""
     env, ctx = environment(), _context(robot)
+    plan = robot.products.gpu_scene
+    gpu = plan is not None and "none" not in plan  # a kit without a GPU scene says why instead
     return {
         layout.example(name): env.get_template(f"examples/{name}.j2").render(ctx).encode("utf-8")
         for name in ("mujoco_demo.py", "pybullet_demo.py", "mjx_demo.py")
-        if name != "mjx_demo.py" or robot.products.gpu_scene is not None
+        if name != "mjx_demo.py" or gpu
     }

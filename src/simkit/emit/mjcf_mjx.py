@@ -136,15 +136,20 @@ def _contact(robot: Robot, mujoco: ET.Element, worldbody: ET.Element) -> None:
 def emit(robot: Robot) -> dict[str, bytes]:
     """`mjcf/NAME_mjx.xml` (nothing before the GPU scene is derived)."""
     plan = robot.products.gpu_scene
-    if plan is None:
+    if plan is None or "none" in plan:
         return {}
     file = layout.mjcf_mjx(robot.name)
     option = {"iterations": num(plan["iterations"]), "ls_iterations": num(plan["ls_iterations"])}
     mujoco = mjcf.head(robot, f"{robot.name}_mjx", file, option)
-    sub(mujoco, "size", nconmax=num(plan["nconmax"]), njmax=num(plan["njmax"]))
+    # MuJoCo Warp's sizes as custom numerics, not `<size nconmax njmax>`: there C MuJoCo (and
+    # MJX, which loads through it) sizes its arena from njmax squared, and a large humanoid's
+    # file could not load ("Could not allocate memory"); the code that makes Warp's data reads
+    # them (examples/mjx_demo.py, scripts/bench_gpu.py)
+    custom = sub(mujoco, "custom")
+    sub(custom, "numeric", name="warp_nconmax", data=num(plan["nconmax"]))
+    sub(custom, "numeric", name="warp_njmax", data=num(plan["njmax"]))
     capped = plan["contact_slots"] < plan["pair_slots"]
     if capped or plan.get("max_geom_pairs") is not None:
-        custom = sub(mujoco, "custom")
         if capped:
             sub(custom, "numeric", name="max_contact_points", data=num(plan["contact_slots"]))
         if plan.get("max_geom_pairs") is not None:

@@ -202,6 +202,8 @@ def document(robot: Robot, reports: SimReports) -> dict:
         doc["geometry"]["self_collision"] = reports.self_collision
     _generalise(robot, doc)
     doc.update(_products(robot, reports))
+    if (doc.get("gpu_scene") or {}).get("file", "") is None:  # no GPU scene: one line says why
+        doc["files"].pop("mjcf_mjx")
     return doc
 
 
@@ -224,10 +226,12 @@ def _products(robot: Robot, reports: SimReports) -> dict:
 
 def gpu_scene(robot: Robot) -> dict | None:
     """robot.json `gpu_scene`: the GPU scene's file, contact budget and sizes (the plan's
-    colliders stay in the file itself)."""
+    colliders stay in the file itself), or the one line saying why the kit has none."""
     plan = robot.products.gpu_scene
     if plan is None:
         return None
+    if "none" in plan:
+        return {"file": None, "note": plan["none"]}
     out = {
         "file": layout.mjcf_mjx(robot.name),
         "contact_slots": plan["contact_slots"],
@@ -241,9 +245,13 @@ def gpu_scene(robot: Robot) -> dict | None:
         "seed": plan["seed"],
         "samples": plan["samples"],
     }
+    if "hold" in plan:
+        out["solver"]["hold_error_m"] = plan["hold"]
     if plan.get("max_geom_pairs") is not None:
         out["max_geom_pairs"] = plan["max_geom_pairs"]
         out["broadphase_rank"] = plan["broadphase_rank"]
+        if plan.get("broadphase_draws"):
+            out["broadphase_draws"] = plan["broadphase_draws"]
     if "note" in plan:
         out["note"] = plan["note"]
     return out
