@@ -1,6 +1,7 @@
 """Write: the draft's spec as YAML (the report as a comment header, then the spec,
-deterministic), validated once, moved into the output folder with its meshes (output.py), the
-source kept beside it (provenance.py); a refusal names the source element (located.py)."""
+deterministic), validated once, moved into the output folder with its meshes and the kept
+source the format wrote into the staging folder (output.py); a refusal names the source
+element (located.py)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from pathlib import Path
 import yaml
 
 from simkit.importer.draft import Draft
-from simkit.importer.write import located, provenance
+from simkit.importer.write import located
 from simkit.importer.write.output import publish
 from simkit.kitio.oneline import one_line
 
@@ -63,7 +64,6 @@ def finish(draft: Draft, out_dir: Path) -> Path:
     """Write the draft's spec once, validate it once (`check`), and copy it with its meshes
     from the staging folder into `out_dir`; a mesh the spec written there before used and
     this one does not is removed (no stale meshes). Returns the spec's path in `out_dir`."""
-    provenance.keep(draft)
     name = draft.spec["name"]
     staged = draft.stage / f"{name}.yaml"
     staged.write_text(spec_yaml(draft.spec, draft.report.lines, draft.path), encoding="utf-8")
