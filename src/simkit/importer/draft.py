@@ -117,6 +117,16 @@ class Draft:
         self.resolved = None
 
     @property
+    def source_noun(self) -> str:
+        """The source format's word, for report lines ("URDF", "MJCF")."""
+        return self.source.noun
+
+    @property
+    def a_noun(self) -> str:
+        """The source format's word with its article, for report lines ("an MJCF")."""
+        return self.source.a_noun
+
+    @property
     def floating(self) -> bool:
         return bool(self.spec.get("floating_base"))
 

@@ -5,13 +5,17 @@ robot.json's `source.format` (the import's formats.FORMATS row) picks the compar
 the importer's reader: urdf.py (yourdfpy; a xacro's kept source is its expansion, a URDF)
 and mjcf.py (MuJoCo compiles both the source and the kit's MJCF). Both also compare the
 source with the kit's USD (kit_usd.py). First the given file's digest is checked against the
-one the import recorded (shared.py). A kit imported before robot.json named the format is
-read by its kept file's suffix (`.xml`: MJCF).
+one the import recorded, or the original's (shared.py): the file the user imported (a URDF,
+a xacro expanded with the recorded args) is read again as the import read it, and must give
+the kept file. A kit imported before robot.json named the format is read by its kept
+file's suffix (`.xml`: MJCF).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import tempfile
+from pathlib import Path
+from types import ModuleType
 
 from simkit.check.findings import Finding
 from simkit.check.kit import Kit
@@ -20,12 +24,10 @@ from simkit.check.source.shared import Allowed, digest
 
 __all__ = ["COMPARE", "Allowed", "check_source", "format_of"]
 
-#: robot.json `source.format` -> the comparison of the kit with its source
-COMPARE: dict[str, Callable[[Kit], list[Finding]]] = {
-    "urdf": urdf.compare,
-    "xacro": urdf.compare,
-    "mjcf": mjcf.compare,
-}
+#: robot.json `source.format` -> the module proving the kit is that source: its
+#: `compare(kit, path)` (the findings) and `remake(path, args)` (the kept file's bytes made
+#: from the original the user imported)
+COMPARE: dict[str, ModuleType] = {"urdf": urdf, "xacro": urdf, "mjcf": mjcf}
 
 
 def format_of(doc: dict) -> str:
@@ -43,4 +45,11 @@ def check_source(kit: Kit) -> list[Finding]:
     findings otherwise (a hand-written spec has no source)."""
     if kit.source is None:
         return []
-    return digest(kit, kit.source) + COMPARE[format_of(kit.doc)](kit)
+    proof = COMPARE[format_of(kit.doc)]
+    found, data = digest(kit, kit.source, proof.remake)
+    if data == kit.source.read_bytes():
+        return found + proof.compare(kit, kit.source)
+    with tempfile.TemporaryDirectory(prefix="simkit-source-") as tmp:
+        made = Path(tmp) / kit.source.name  # the kept file, made from the original
+        made.write_bytes(data)
+        return found + proof.compare(kit, made)

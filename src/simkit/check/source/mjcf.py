@@ -43,23 +43,28 @@ SHOWN = 20
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 
 
-def compare(kit: Kit) -> list[Finding]:
-    """Findings for the MJCF source `kit.source` against the kit's MJCF, differences
+def remake(path: Path, args: dict[str, str]) -> bytes:
+    """The kept file made from the original: an MJCF is kept byte for byte."""
+    return path.read_bytes()
+
+
+def compare(kit: Kit, path: Path) -> list[Finding]:
+    """Findings for the MJCF source at `path` against the kit's MJCF, differences
     allowed where robot.json lists them (shared.Allowed: listed keys and renames)."""
     import mujoco
 
     allowed = Allowed.of(kit.doc)
     recorded = kit.doc.get("source") or {}
-    if hashlib.sha256(kit.source.read_bytes()).hexdigest() != recorded.get("sha256"):
+    if hashlib.sha256(path.read_bytes()).hexdigest() != recorded.get("sha256"):
         return []  # not the file the import read (source.digest fails): never compiled
     assets = recorded.get("assets") or {}
     with tempfile.TemporaryDirectory(prefix="simkit-source-") as tmp:
         folder = Path(tmp)
-        problems = _lay_out(kit.source, assets, folder)
+        problems = _lay_out(path, assets, folder)
         if problems:
             return [require("source.digest", False, p) for p in problems[:SHOWN]]
         try:
-            source = mujoco.MjSpec.from_file(str(folder / kit.source.name)).compile()
+            source = mujoco.MjSpec.from_file(str(folder / path.name)).compile()
         except Exception as exc:
             why = " ".join(str(exc).split())[:200]
             return [require("source.read", False, f"MuJoCo cannot compile the source: {why}")]

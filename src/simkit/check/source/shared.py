@@ -1,5 +1,6 @@
 """What every format's source proof shares: robot.json's listed differences (`Allowed`),
-the tolerances, and the digest of the given source file."""
+the tolerances, and the identity of the given source file (`digest`): the kept copy, or
+the original the user imported."""
 
 from __future__ import annotations
 
@@ -9,6 +10,8 @@ from pathlib import Path
 
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.errors import SimkitError
+from simkit.kitio.oneline import one_line
 
 #: relative tolerance: the kit carries 10 significant digits (kitio/fmt.py); a hand-typed
 #: source rarely more. Far below any real change (an axis turned, a mass 10 % off).
@@ -41,19 +44,39 @@ class Allowed:
         return out
 
 
-def digest(kit: Kit, path: Path) -> list[Finding]:
-    """The source file is the one the import recorded (robot.json `source.sha256`)."""
-    recorded = (kit.doc.get("source") or {}).get("sha256")
-    if recorded is None:
-        return []
-    actual = hashlib.sha256(path.read_bytes()).hexdigest()
-    return [
-        require(
-            "source.digest",
-            actual == recorded,
-            f"{path.name} is the file the import recorded (sha256 {recorded[:12]}...)"
-            if actual == recorded
-            else f"{path.name} was changed after the import: sha256 {actual[:12]}..., "
-            f"robot.json records {recorded[:12]}...",
+def digest(kit: Kit, path: Path, remake) -> tuple[list[Finding], bytes]:
+    """The given file is the one the import kept (robot.json `source.sha256`) or the one
+    the user imported (`source.original`: a URDF or xacro, made into the kept file again by
+    `remake(path, args)`, which must give the kept digest). Returns the finding and the
+    bytes to compare the kit with (the given file's, unless it is the original)."""
+    recorded = kit.doc.get("source") or {}
+    data = path.read_bytes()
+    actual = hashlib.sha256(data).hexdigest()
+    kept, original = recorded.get("sha256"), recorded.get("original")
+    if kept is None:
+        return [], data
+    if actual == kept:
+        said = f"{path.name} is the file the import recorded (sha256 {kept[:12]}...)"
+        return [require("source.digest", True, said)], data
+    if actual != original:
+        said = (
+            f"{path.name} was changed after the import: sha256 {actual[:12]}..., robot.json "
+            f"records {kept[:12]}...{f' (the original {original[:12]}...)' if original else ''}"
         )
-    ]
+        return [require("source.digest", False, said)], data
+    try:
+        made = remake(path, dict(recorded.get("args") or {}))
+    except SimkitError as exc:
+        said = f"{path.name} is the imported file, but it no longer reads: {exc}"
+        return [require("source.digest", False, one_line(said))], data
+    if hashlib.sha256(made).hexdigest() != kept:
+        said = (
+            f"{path.name} is the imported file (sha256 {actual[:12]}...), but it does not read "
+            "as the import read it (a file it includes, or the environment, changed)"
+        )
+        return [require("source.digest", False, said)], data
+    said = (
+        f"{path.name} is the file the user imported (sha256 {actual[:12]}...); read as the "
+        f"import read it, it gives the kept file (sha256 {kept[:12]}...)"
+    )
+    return [require("source.digest", True, said)], made

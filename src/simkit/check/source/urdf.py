@@ -103,15 +103,28 @@ def _read_leniently(path: Path) -> tuple[object | None, list[str]]:
     return (robot if fixes else None), fixes
 
 
-def compare(kit: Kit) -> list[Finding]:
-    """The comparison of the URDF source `kit.source` (yourdfpy) with the kit's URDF, and
-    of the source with the kit's USD (kit_usd.py)."""
+def remake(path: Path, args: dict[str, str]) -> bytes:
+    """The kept URDF made anew from the original file the user imported (a URDF, or a xacro
+    expanded with the import's `args`), read by the importer's reader as the import read it
+    (formats/urdf.py `serialised`); SpecError when it cannot be read."""
+    from simkit.importer import formats
+    from simkit.importer.diagnostics import Report
+    from simkit.importer.formats import urdf as urdf_format
+    from simkit.importer.read.options import ReadOptions
+
+    doc = formats.load(path, (), Report(), ReadOptions(tuple(sorted(args.items()))))
+    return urdf_format.serialised(doc.kept)
+
+
+def compare(kit: Kit, path: Path) -> list[Finding]:
+    """The comparison of the URDF source at `path` (yourdfpy) with the kit's URDF, and of
+    the source with the kit's USD (kit_usd.py)."""
     findings: list[Finding] = []
     try:
-        source = load_urdf(kit.source)
+        source = load_urdf(path)
     except Exception as exc:  # yourdfpy raises several types on bad input
         why = " ".join(str(exc).split())[:200]
-        source, fixes = _read_leniently(kit.source)
+        source, fixes = _read_leniently(path)
         if source is None:
             fail = f"yourdfpy cannot read the source: {why}"
             return [*findings, require("source.read", False, fail)]

@@ -18,6 +18,7 @@ row accepts every file, so it comes last. A new format is one module here and on
 
 from __future__ import annotations
 
+import hashlib
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -39,14 +40,16 @@ class Format:
     title: Callable[[bytes], str | None]
     read: Callable[[Source, ReadOptions], Source]
     keep: Callable[[object], None]
+    noun: str = "URDF"
     edits: tuple[Callable[[object], None], ...] = ()
     after: tuple[Callable[[object], None], ...] = ()
 
 
 def _module_row(name: str, module) -> Format:
     return Format(
-        name, module.sniff, module.title, module.read, module.keep, module.EDITS, module.AFTER
-    )
+        name, module.sniff, module.title, module.read, module.keep, module.NOUN, module.EDITS,
+        module.AFTER,
+    )  # fmt: skip
 
 
 #: the formats, in the order `pick` tries them (the URDF, which takes any file, last)
@@ -98,5 +101,8 @@ def load(
     source = read.shell(path, package_dirs, report, options)
     fmt = (picked or pick(path)).format
     done = fmt.read(source, options)
-    done.format = fmt.name
+    for doc in (done, done.kept):
+        doc.format, doc.noun = fmt.name, fmt.noun
+    done.original = hashlib.sha256(path.read_bytes()).hexdigest()
+    done.args = options.args()
     return done

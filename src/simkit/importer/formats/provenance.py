@@ -12,6 +12,7 @@ URDF's names: `links.L.FIELD`, `joints.J.FIELD`, `links.L.name` (renamed, `kit` 
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import replace
 
 from simkit.importer.diagnostics import Report
@@ -33,6 +34,19 @@ GENERIC = {
     "max_velocity": "the URDF's velocity limit is missing or a placeholder: estimated",
     "effort_peak": "the URDF's effort limit is missing or a placeholder: estimated",
 }
+
+
+def entry(draft, name: str, data: bytes) -> dict:
+    """The spec's `source` entry of a kept file `name` holding `data`: its digest, the
+    format, and the original's digest and the --xacro-arg values where they matter (the
+    kept file is not the original byte for byte; the file was read with arguments)."""
+    source = draft.source
+    out = {"file": name, "format": source.format, "sha256": hashlib.sha256(data).hexdigest()}
+    if source.original and source.original != out["sha256"]:
+        out["original"] = source.original
+    if source.args:
+        out["args"] = dict(sorted(source.args.items()))
+    return out
 
 
 def as_read(source: Source) -> Source:
@@ -76,13 +90,15 @@ def differences(
             said = _said(records, source, element)
             for field in item.get("estimated", []):
                 if field in fields:
-                    add(f"{kind}.{old}.{field}", said or GENERIC[field])
+                    generic = GENERIC[field].replace("URDF", source.noun)
+                    add(f"{kind}.{old}.{field}", said or generic)
             if kind == "links" and element is not None:
                 _dropped(records, source, element, f"links.{old}", add)
             if kind == "links" and item.get("inertia_decision"):
                 add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
             if kind == "joints" and element is not None and element.get("type") != item["type"]:
-                add(f"joints.{old}.type", said or f"a {element.get('type')} joint in the URDF")
+                kind_in = f"a {element.get('type')} joint in the {source.noun}"
+                add(f"joints.{old}.type", said or kind_in)
     _massless(source, add)
     return [out[k] for k in sorted(out)]
 
@@ -98,7 +114,9 @@ def _massless(source: Source, add) -> None:
         except ValueError:
             massless = False
         if massless:
-            reason = "a massless link in the URDF: a body without mass has no CoM or inertia"
+            reason = (
+                f"a massless link in the {source.noun}: a body without mass has no CoM or inertia"
+            )
             add(f"links.{link.get('name')}.com", reason)
             add(f"links.{link.get('name')}.inertia", reason)
 
@@ -110,12 +128,14 @@ def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
     if source.root.find(f"link[@name='{old}']") is not None:
         return  # the URDF's own massless root link is the kit's root
     if source.root.find(f"joint/parent[@link='{old}']") is not None:  # formats/urdf/repairs.py
-        add(f"links.{root}", "added: the frame the URDF mounts the robot on, named, not declared")
+        said = f"added: the frame the {source.noun} mounts the robot on, named, not declared"
+        add(f"links.{root}", said)
         return
     for joint in spec["joints"]:
         if joint["parent"] == root and joint["type"] == "fixed":
             add(f"links.{root}", "added: the world the fixed base is bolted to")
-            add(f"joints.{joint['name']}", "added: bolts the URDF's root link to the world")
+            said = f"added: bolts the {source.noun}'s root link to the world"
+            add(f"joints.{joint['name']}", said)
 
 
 #: joint fields the source check compares, listed for a joint the kit had to reshape
@@ -130,7 +150,9 @@ def _reshaped(spec: dict, source: Source, report: Said, back: dict[str, str], ad
     for element in source.root.findall("joint"):  # the robot's joints, not a block's
         if element.get("type") in kinds or not element.get("name"):
             continue
-        said = _said(report, source, element) or f"a {element.get('type')} joint in the URDF"
+        said = _said(report, source, element) or (
+            f"a {element.get('type')} joint in the {source.noun}"
+        )
         name = element.get("name")
         for field in RESHAPED:
             add(f"joints.{name}.{field}", said)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import PurePosixPath
 
+from simkit.importer.formats import provenance
 from simkit.importer.formats.mjcf.reader import MjcfSource
 
 
@@ -32,7 +33,7 @@ def keep(draft, source: MjcfSource) -> dict:
         assets[rel] = digest
         folder.mkdir(exist_ok=True)
         (folder / f"{digest}{PurePosixPath(rel).suffix.lower()}").write_bytes(data)
-    entry = {"file": name, "sha256": hashlib.sha256(main).hexdigest()}
+    entry = provenance.entry(draft, name, main)
     if assets:
         entry["assets"] = assets
     return entry

@@ -13,7 +13,6 @@ The xacro format (formats/xacro.py) expands the file, then reads it as this one 
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 
 from simkit.importer.formats import provenance
@@ -52,17 +51,23 @@ def repaired(source: Source) -> Source:
 def keep(draft) -> None:
     """Write the URDF as read (`draft.kept`) into the staging folder as NAME.source.urdf,
     and add `source` and `source_differences` to the spec."""
-    from lxml import etree
-
     original = draft.kept
-    data = etree.tostring(original.root.getroottree(), xml_declaration=True, encoding="utf-8")
-    data = data.rstrip(b"\n") + b"\n"
+    data = serialised(original)
     spec = draft.spec
     name = f"{spec['name']}.source.urdf"
     (draft.stage / name).write_bytes(data)
-    spec["source"] = {"file": name, "sha256": hashlib.sha256(data).hexdigest()}
+    spec["source"] = provenance.entry(draft, name, data)
     spec["source_differences"] = provenance.differences(spec, original, draft.report, draft.renames)
     draft.changed()
+
+
+def serialised(kept: Source) -> bytes:
+    """The kept URDF's bytes: the document as read, re-serialised (comments dropped). The
+    source check makes them again from the original file (check/source/urdf.py)."""
+    from lxml import etree
+
+    data = etree.tostring(kept.root.getroottree(), xml_declaration=True, encoding="utf-8")
+    return data.rstrip(b"\n") + b"\n"
 
 
 def keep_blocks(draft) -> None:
