@@ -244,7 +244,7 @@ def test_imported_arm_builds(tmp_path, kit_factory):
 
 def test_large_cad_meshes_leave_the_step_out(tmp_path, monkeypatch):
     """Over the triangle budget the spec says `step: false`, with one report line."""
-    from simkit.importer.translate import step_budget
+    from simkit.importer.fixups import step_budget
 
     small = import_robot(ARM, tmp_path / "a")
     assert load_spec(small.spec_path)[0].step is True

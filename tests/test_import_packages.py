@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from simkit.errors import SpecError
-from simkit.importer import import_robot, read
+from simkit.importer import formats, import_robot
 from simkit.importer.diagnostics import Report
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.packages import MissingMesh, PackageMap, package_root
@@ -42,7 +42,7 @@ def _write(path: Path, text: str | None = None) -> Path:
 
 def _lines(urdf: Path, **options) -> tuple[str, ...]:
     report = Report()
-    doc = read.load(urdf, (), report, ReadOptions(**options))
+    doc = formats.load(urdf, (), report, ReadOptions(**options))
     mesh = doc.root.find("link/visual/geometry/mesh")
     resolve_uri(doc, mesh, mesh.get("filename"))
     return tuple(report.lines)

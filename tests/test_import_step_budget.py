@@ -10,7 +10,7 @@ import yaml
 
 from simkit.derive.solids import primitive_solid
 from simkit.importer import import_robot
-from simkit.importer.translate.step_budget import FACETED, MAX_TRIANGLES
+from simkit.importer.fixups.step_budget import FACETED, MAX_TRIANGLES
 from simkit.model.robot import Shape
 
 

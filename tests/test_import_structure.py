@@ -1,4 +1,4 @@
-"""The importer's structure (issue 31): one reader per format behind one table, one
+"""The importer's structure (issue 31; the formats' table: test_import_formats_table.py): one
 diagnostic record whose policy `--strict` promotes, one typed draft every step receives,
 and one builder for the scratch MuJoCo models. Small handwritten URDFs."""
 
@@ -12,9 +12,10 @@ import pytest
 from lxml import etree
 
 from simkit.errors import SpecError
-from simkit.importer import STEPS, import_robot, read
+from simkit.importer import import_robot, steps
 from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.fixups import collide, scratch
+from simkit.importer.formats import FORMATS
 from simkit.importer.read.source import Source
 from simkit.model.resolve import resolve
 from simkit.spec.validate import load_spec
@@ -26,28 +27,6 @@ ARM = Path(__file__).resolve().parent / "specs" / "urdf" / "pkg_demo" / "urdf" /
 def _source(tmp_path: Path, report: Report) -> tuple[Source, object]:
     root = etree.fromstring(b'<robot name="r">\n<link name="a"/>\n<link name="b"/>\n</robot>')
     return Source(tmp_path / "r.urdf", root, packages=None, report=report), root
-
-
-def test_the_reader_is_chosen_by_what_the_file_is(tmp_path):
-    assert [read.kind_of(Path(n)) for n in ("a.urdf", "a.xacro", "a.urdf.xacro", "a.URDF")] == [
-        "urdf",
-        "xacro",
-        "xacro",
-        "urdf",
-    ]
-    assert set(read.READERS) == {"urdf", "xacro", "mjcf"}
-    model = tmp_path / "m.xml"  # an MJCF by its root element, not its name
-    model.write_text("<!-- a model -->\n<mujoco model='m'><worldbody/></mujoco>")
-    assert read.kind_of(model) == "mjcf"
-    (tmp_path / "u.xml").write_text("<robot name='r'><link name='a'/></robot>")
-    assert read.kind_of(tmp_path / "u.xml") == "urdf"
-    xacro = tmp_path / "r.urdf.xacro"
-    xacro.write_text(
-        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
-        '<xacro:property name="n" value="base"/><link name="${n}"/></robot>'
-    )
-    doc = read.load(xacro, (), Report())
-    assert [e.get("name") for e in doc.root.iter("link")] == ["base"]
 
 
 def test_the_policy_makes_an_estimate_a_warning_and_strict_an_error(tmp_path):
@@ -72,9 +51,11 @@ def test_the_policy_makes_an_estimate_a_warning_and_strict_an_error(tmp_path):
         source.lenient(links[1], "'xyz' is '0, 0, 1'")
 
 
-def test_every_step_receives_only_the_draft():
-    assert STEPS[0].__name__ == "to_spec"
-    assert [list(inspect.signature(step).parameters) for step in STEPS] == [["draft"]] * len(STEPS)
+@pytest.mark.parametrize("fmt", FORMATS, ids=lambda f: f.name)
+def test_every_step_receives_only_the_draft(fmt):
+    found = steps(fmt)
+    assert found[0].__name__ == "to_spec"
+    assert [list(inspect.signature(step).parameters) for step in found] == [["draft"]] * len(found)
 
 
 def test_the_scratch_builder_compiles_the_collision_model(tmp_path):

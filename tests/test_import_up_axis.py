@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from simkit.importer import import_robot
-from simkit.importer.read import load
+from simkit.importer.formats import load
 from simkit.importer.translate.up_axis import is_y_up, turn_y_up
 
 

@@ -11,7 +11,8 @@ import pytest
 import yaml
 from click.testing import CliRunner
 
-from simkit.check.source import Allowed, compare_robots, load_urdf
+from simkit.check.source import Allowed
+from simkit.check.source.urdf import compare_robots, load_urdf
 from simkit.errors import CheckFailed, SpecError
 from simkit.importer import import_robot
 from simkit.spec.validate import load_spec

@@ -5,7 +5,7 @@ finding says which fix applied; a source no fix makes readable still fails."""
 
 from __future__ import annotations
 
-from simkit.check.source import _read_leniently, load_urdf
+from simkit.check.source.urdf import _read_leniently, load_urdf
 from simkit.importer import import_robot
 from urdf_parts import joint, link, write
 

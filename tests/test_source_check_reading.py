@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import yaml
 
-from simkit.check.source import load_urdf
+from simkit.check.source.urdf import load_urdf
 from simkit.importer import import_robot
 
 URDF = """<?xml version="1.0"?>

@@ -1,4 +1,4 @@
-"""The source proof reads the composed USD stage (issue 33, check/source_usd.py): each
+"""The source proof reads the composed USD stage (issue 33, check/source/kit_usd.py): each
 link's mass and each movable joint's type and limits in the kit's entry USD, composed with
 its payloads, agree with the imported URDF's. A tampered physics payload fails."""
 

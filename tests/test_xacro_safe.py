@@ -12,9 +12,9 @@ from lxml import etree
 
 from simkit.cli import main
 from simkit.errors import SpecError
-from simkit.importer import read
+from simkit.importer import formats
 from simkit.importer.diagnostics import Report
-from simkit.importer.read import xacro as xacro_safe
+from simkit.importer.formats import xacro as xacro_safe
 from simkit.importer.read.options import ReadOptions
 
 HEAD = '<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
@@ -31,7 +31,7 @@ def _xacro(tmp_path: Path, body: str, name: str = "r.urdf.xacro") -> Path:
 
 
 def _load(path: Path, **options) -> etree._Element:
-    return read.load(path, (), Report(), ReadOptions(**options)).root
+    return formats.load(path, (), Report(), ReadOptions(**options)).root
 
 
 def _names(root) -> list[str]:

@@ -76,7 +76,7 @@ def run_checks(
     kit_dir: Path, checks: Mapping[str, Check] | None = None, source: Path | None = None
 ) -> list[Finding]:
     """Every finding for the kit at `kit_dir`, in a stable order; `source`: the URDF it was
-    imported from, for the source comparison (check/source.py)."""
+    imported from, for the source comparison (check/source)."""
     kit = Kit.open(kit_dir, source)
     checks = checks or CHECKS
     jobs = {name: partial(_guarded, name, check, kit) for name, check in checks.items()}

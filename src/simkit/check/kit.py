@@ -18,7 +18,7 @@ class Kit:
     """A kit folder on disk."""
 
     root: Path
-    #: the URDF the kit was imported from (check/source.py compares them), when given
+    #: the URDF the kit was imported from (check/source compares them), when given
     source: Path | None = None
 
     @staticmethod

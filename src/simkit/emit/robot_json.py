@@ -383,6 +383,8 @@ def emit(
         doc["source"] = {"file": robot.source[0], "sha256": robot.source[1]}
         if robot.source_assets:
             doc["source"]["assets"] = dict(robot.source_assets)
+        for key, value in robot.source_about:  # format, original, args (model/resolve.py)
+            doc["source"][key] = dict(value) if key == "args" else value
         doc["source_differences"] = [
             {"what": what, "reason": reason, **({"kit": kit} if kit is not None else {})}
             for what, reason, kit in robot.source_differences

@@ -1,40 +1,57 @@
-"""`simkit import`: a URDF (or xacro) to a spec plus the meshes it needs (issue 15).
+"""`simkit import`: a URDF, xacro or MJCF to a spec plus the meshes it needs (issue 15).
 
-The spec keeps the URDF's numbers exactly; gaps are filled with plausible values listed under
-`estimated` and reported one line each (`--strict` refuses them), and every element simkit
-does not keep is reported too. Output: DIR/NAME.yaml and DIR/meshes/*.stl (relative paths),
-written only when the whole import succeeded.
+The spec keeps the source's numbers exactly; gaps are filled with plausible values listed
+under `estimated` and reported one line each (`--strict` refuses them), and every element
+simkit does not keep is reported too. Output: DIR/NAME.yaml and DIR/meshes/*.stl (relative
+paths), written only when the whole import succeeded.
 
-Sub-packages by concern, each importing only those before it (an import-linter contract,
-docs/architecture.md): `read/` (one reader per format behind one table, to a `Source`),
-`translate/` (the source to the draft's spec), `fixups/` (pose and mass steps that read only
-the draft), `write/` (provenance, the YAML written and validated once, the files moved into
-place). Below them sit `draft.py` (the one typed object every step receives) and
-`diagnostics.py` (the one record and policy every step reports through).
+Sub-packages by concern, each importing only those below it (an import-linter contract,
+docs/architecture.md): `formats/` (one module per format behind one table: what a file is,
+its reader, its kept source) and `write/` (the YAML written and validated once, the files
+moved into place), then `fixups/` (spec edits, pose and mass steps that read the draft),
+`translate/` (the read `Source` to the draft's spec, no format known), `draft.py` (the one
+typed object every step receives), `read/` (what every reader shares) and `diagnostics.py`
+(the one record and policy every step reports through).
 
-The import reads the file, then passes one draft through `STEPS` in order (translate.to_spec,
-then fixups.STEPS: rotors, base, home, stand, limits), then `write.finish`, which keeps the
-source (write/provenance.py), writes and validates the spec once, and moves the files into
-place whole (write/output.py). The staging folder is removed on every way out.
+The import picks the format once (formats.pick: the file's head read once), reads the file,
+then passes one draft through `steps(format)` in order: translate.to_spec, the names made
+legal, the format's edits, the refusals `--strict` asks for, the STEP budget, fixups.STEPS
+(rotors, base, home, stand, limits) and the format's last steps; then the format keeps its
+source (`keep`) and `write.finish` writes and validates the spec once and moves the files
+into place whole (write/output.py). The staging folder is removed on every way out.
 """
 
 from __future__ import annotations
 
 import re
+import shutil
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from simkit.errors import SpecError
-from simkit.importer import fixups, read, translate, write
+from simkit.importer import fixups, formats, translate, write
 from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.draft import DENSITY, Draft, Options, Unresolvable
-from simkit.importer.read import mjcf
+from simkit.importer.fixups import names, step_budget
+from simkit.importer.formats import Format
 from simkit.importer.read.options import ReadOptions
-from simkit.importer.write import provenance
 from simkit.importer.write.output import staging
 
-#: the import's steps, in order: each receives the draft and changes it
-STEPS = (translate.to_spec, *fixups.STEPS)
+
+def _refused(draft: Draft) -> None:
+    """Stop on the first problem `--strict` refuses (after the names and the format's
+    edits, which may report more)."""
+    draft.report.raise_refused()
+
+
+def steps(fmt: Format) -> tuple[Callable[[Draft], None], ...]:
+    """The import's steps for a file of format `fmt`, in order: each receives the draft
+    and changes it."""
+    return (
+        translate.to_spec, names.legal, *fmt.edits, _refused, step_budget.fit,
+        *fixups.STEPS, *fmt.after,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -47,10 +64,11 @@ class Imported:
     links: int
 
 
-def robot_name(path: Path) -> str:
-    """A spec name (`[a-z][a-z0-9_]*`) from an MJCF's `model` attribute, else the file name."""
-    model = mjcf.model_name(path) if mjcf.is_mjcf(path) else None
-    stem = (model or path.name.split(".")[0]).lower()
+def robot_name(path: Path, picked: formats.Picked | None = None) -> str:
+    """A spec name (`[a-z][a-z0-9_]*`) from the name the file gives its robot (an MJCF's
+    `model` attribute; `picked`, else the file's head is read), else the file name."""
+    title = (picked or formats.pick(path)).title
+    stem = (title or path.name.split(".")[0]).lower()
     name = re.sub(r"[^a-z0-9_]+", "_", stem).strip("_") or "robot"
     return name if name[0].isalpha() else f"robot_{name}"
 
@@ -73,19 +91,25 @@ def import_robot(
     `density` (kg/m^3, default draft.DENSITY): a massless link's mass from its solid.
     `reading`: what the reader may do (xacro args, environment, files outside the package;
     importer/read/options.py)."""
-    name = name or robot_name(path)
+    picked = formats.pick(path)  # the file's head read once
+    name = name or robot_name(path, picked)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")
     options = Options(name, floating, hull_collision, density or DENSITY)
     report = Report(Policy(strict=strict))
-    doc = read.load(path, package_dirs, report, reading)
-    kept = provenance.as_read(doc)  # before any rewrite (spherical joints)
-    with staging(out_dir) as stage:  # removed on every way out, SIGTERM included
-        draft = Draft(doc, path, stage, report, options, kept=kept)
-        try:
-            for step in STEPS:
-                step(draft)
-        except Unresolvable:
-            write.refuse(draft)
-        spec_path = write.finish(draft, out_dir)
+    doc = formats.load(path, package_dirs, report, reading, picked)
+    fmt = picked.format
+    try:
+        with staging(out_dir) as stage:  # removed on every way out, SIGTERM included
+            draft = Draft(doc, path, stage, report, options, kept=doc.kept)
+            try:
+                for step in steps(fmt):
+                    step(draft)
+            except Unresolvable:
+                write.refuse(draft)
+            fmt.keep(draft)  # the kept source, `source` and `source_differences`
+            spec_path = write.finish(draft, out_dir)
+    finally:
+        for folder in doc.scratch:  # what the reader wrote for the translation
+            shutil.rmtree(folder, ignore_errors=True)
     return Imported(spec_path, tuple(report.lines), draft.meshes, len(draft.spec["links"]))

@@ -102,6 +102,12 @@ class Draft:
         chose, at `where` (an element `where()` gave), else the document's root."""
         self.report.assumed(self.source, self.source.root if where is None else where, message)
 
+    def note_named(self, tag: str, name: str, message: str) -> None:
+        """A report record (`changed`) at the first `<tag name=...>` anywhere in the source
+        (a renamed link or joint, by its source name)."""
+        element = next((e for e in self.source.root.iter(tag) if e.get("name") == name), None)
+        self.report.changed(self.source, element, message)
+
     def note_change(self, message: str) -> None:
         """A report record (`changed`) of the robot kept in another form, at the root."""
         self.report.changed(self.source, self.source.root, message)
@@ -109,6 +115,16 @@ class Draft:
     def changed(self) -> None:
         """Forget the resolved model after a change of `spec`."""
         self.resolved = None
+
+    @property
+    def source_noun(self) -> str:
+        """The source format's word, for report lines ("URDF", "MJCF")."""
+        return self.source.noun
+
+    @property
+    def a_noun(self) -> str:
+        """The source format's word with its article, for report lines ("an MJCF")."""
+        return self.source.a_noun
 
     @property
     def floating(self) -> bool:

@@ -224,6 +224,18 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         license=spec.license,
         source=None if spec.source is None else (spec.source.file, spec.source.sha256),
         source_assets=() if spec.source is None else tuple(sorted(spec.source.assets.items())),
+        source_about=_source_about(spec),
         source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
         contact_excludes=tuple(sorted(tuple(sorted(p)) for p in spec.contact_excludes)),
     )
+
+
+def _source_about(spec: RobotSpec) -> tuple[tuple[str, object], ...]:
+    """robot.json's `source` keys beyond file, digest and assets: the format, the
+    original's digest and the xacro args, those the spec gives."""
+    if spec.source is None:
+        return ()
+    about = {"format": spec.source.format, "original": spec.source.original}
+    if spec.source.args:
+        about["args"] = tuple(sorted(spec.source.args.items()))
+    return tuple((k, v) for k, v in about.items() if v is not None)

@@ -317,6 +317,9 @@ class Robot:
     source: tuple[str, str] | None = None
     #: an MJCF source's other files: (path relative to the source, SHA-256)
     source_assets: tuple[tuple[str, str], ...] = ()
+    #: the source's format, the original's SHA-256 (when the kept file is not the original)
+    #: and the xacro args, as robot.json's `source` records them: (key, value) pairs
+    source_about: tuple[tuple[str, object], ...] = ()
     #: the kit's intended differences from that source: (what, reason, kit name or None)
     source_differences: tuple[tuple[str, str, str | None], ...] = ()
     #: link pairs the source excludes from contact (spec `contact_excludes`), names sorted

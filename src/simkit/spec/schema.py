@@ -316,12 +316,23 @@ class PlanningGroupSpec(Strict):
 class SourceSpec(Strict):
     """The file a spec was imported from, kept beside it (`simkit import` writes
     NAME.source.urdf, the expanded URDF, or NAME.source.xml, the MJCF), and its SHA-256:
-    the source check compares the kit with it (check/source.py). The kit never carries
+    the source check compares the kit with it (check/source). The kit never carries
     the file, only the digest."""
 
     #: a file name in the spec's folder (no folders, so it cannot point elsewhere)
     file: Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")]
+    #: the importer's format (importer/formats: urdf, xacro, mjcf), which picks the source
+    #: check's comparison; absent in specs imported before it was recorded
+    format: Annotated[str, Field(pattern=r"^[a-z][a-z0-9]{0,15}$")] | None = None
     sha256: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")]
+    #: SHA-256 of the file the user imported, where the kept file is not it byte for byte
+    #: (a URDF re-serialised, a xacro expanded): `simkit check --source` takes either
+    original: Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")] | None = None
+    #: the `--xacro-arg` values the import expanded a xacro with, to expand it again
+    args: dict[
+        Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]{0,99}$")],
+        Annotated[str, Field(max_length=1000)],
+    ] = {}
     #: an MJCF's other files (includes, meshes, textures): path relative to the source's
     #: folder -> SHA-256; kept beside the spec as NAME.source.assets/SHA256.EXT
     assets: dict[

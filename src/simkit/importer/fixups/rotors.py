@@ -78,7 +78,8 @@ def armature(draft: Draft) -> None:
         if by_effort <= bound or bound <= 0.0:
             spec["armature"] = by_effort
             why = (
-                f"no armature in a URDF: {by_effort:g} {unit} ({ARMATURE_PER_EFFORT:g} x effort, "
+                f"no armature in {draft.a_noun}: {by_effort:g} {unit} "
+                f"({ARMATURE_PER_EFFORT:g} x effort, "
                 f"a geared motor's reflected rotor inertia; within {ARMATURE_SHARE:g} x the "
                 f"{own:.3g} {unit} it moves; keeps the servo stable on light links)"
             )
@@ -88,7 +89,8 @@ def armature(draft: Draft) -> None:
             kp = float(f"{SERVO_OMEGA**2 * (own + bound):.3g}")
             spec["kp"] = kp
             why = (
-                f"no armature in a URDF: {bound:g} {unit}, {ARMATURE_SHARE:g} x the {own:.3g} "
+                f"no armature in {draft.a_noun}: {bound:g} {unit}, {ARMATURE_SHARE:g} x the "
+                f"{own:.3g} "
                 f"{unit} the joint moves at home ({ARMATURE_PER_EFFORT:g} x effort, "
                 f"{by_effort:g}, would swamp it); servo kp {kp:g} (not effort / 0.01 rad) so "
                 f"that it stays at {SERVO_OMEGA:.0f} rad/s, stable at the kit's 2 ms step"

@@ -40,7 +40,7 @@ def searched(draft: Draft, what: str) -> bool:
         return True
     draft.note(
         f"{what} skipped: {links} links, more than the {SEARCH_LINKS} the MuJoCo searches "
-        "take (importer/fixups.py SEARCH_LINKS)",
+        "take (importer/fixups/steps.py SEARCH_LINKS)",
     )
     return False
 
@@ -49,7 +49,7 @@ def base(draft: Draft) -> None:
     """A Y-up floating robot lies on its side at the identity: turn its base."""
     if not draft.floating:
         return
-    turned = upright.upright(draft.robot())
+    turned = upright.upright(draft.robot(), draft.source_noun)
     if turned is not None:
         draft.estimate_base(("rpy",), rpy=[float(f"{v:.6g}") for v in turned[0]])
         draft.note(turned[1])

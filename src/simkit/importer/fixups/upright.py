@@ -78,7 +78,7 @@ def limb_ends(robot, poses: dict, base: str) -> np.ndarray:
     return total
 
 
-def upright(robot) -> tuple[tuple[float, float, float], str] | None:
+def upright(robot, noun: str = "URDF") -> tuple[tuple[float, float, float], str] | None:
     """The floating joint's rpy (rad) that stands the robot on its limbs, and why; None where
     the identity does (the limbs hang along -z, or nothing tells)."""
     floating = robot.floating_joint
@@ -97,7 +97,7 @@ def upright(robot) -> tuple[tuple[float, float, float], str] | None:
         return None
     why = (
         f"floating base turned rpy {rpy[0]:.4g} {rpy[1]:.4g} {rpy[2]:.4g} rad: its limbs "
-        f"(feet, hands, head) point along {name} in the URDF ({spread[axis]:.3g} m of links "
+        f"(feet, hands, head) point along {name} in the {noun} ({spread[axis]:.3g} m of links "
         f"along it, {spread[2]:.3g} m along z); turned so that {name} points down"
     )
     return rpy, why

@@ -1,51 +1,28 @@
-"""Readers: a robot file to a `Source` (read/source.py), one reader per format.
+"""Reading, shared by every format: the read document (`Source`, source.py), package and
+file lookup (packages.py), lenient forms (lenient.py), the user's reading options
+(options.py) and the safe expression evaluator (safe_eval.py).
 
-`READERS` maps what the file is (`kind_of`) to its reader (MJCF: MuJoCo itself,
-read/mjcf.py); `load` builds the PackageMap and picks the reader. Each reader takes a
-`Source` shell (path, packages, report; no root yet) and the user's `ReadOptions`, and
-returns it with its document parsed. A new format is one module here and one row in the
-table (Drake's `detail_*_parser` per format).
+The formats themselves (what a file is, its reader, its kept copy) are importer/formats,
+one module per format behind one table; `shell` is the empty `Source` each reader fills.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 
 from simkit.errors import SpecError
 from simkit.importer.diagnostics import Report
-from simkit.importer.read import mjcf, urdf, xacro
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.packages import PackageMap
 from simkit.importer.read.source import Source
 
-#: a reader: the shell `Source` and the options to the parsed `Source`
-Reader = Callable[[Source, ReadOptions], Source]
 
-#: what the file is -> its reader
-READERS: dict[str, Reader] = {"urdf": urdf.read, "xacro": xacro.read, "mjcf": mjcf.read}
-
-
-def kind_of(path: Path) -> str:
-    """What the file is: `xacro` by its name (`.xacro`, `.urdf.xacro`), `mjcf` by its
-    `<mujoco>` root element, else `urdf`."""
-    if path.suffix == ".xacro" or path.name.endswith(".urdf.xacro"):
-        return "xacro"
-    return "mjcf" if mjcf.is_mjcf(path) else "urdf"
-
-
-def load(
-    path: Path,
-    package_dirs: tuple[Path, ...] = (),
-    report: Report | None = None,
-    options: ReadOptions | None = None,
+def shell(
+    path: Path, package_dirs: tuple[Path, ...], report: Report | None, options: ReadOptions
 ) -> Source:
-    """Read `path` with the reader for its kind (a `.xacro` is expanded safely unless
-    trusted); `report` takes the lenient readings (None: they are refused, as with
-    --strict)."""
-    options = options or ReadOptions()
+    """The `Source` of `path` before a reader parses it: its PackageMap (package://
+    lookup, --allow-read folders) and the report; one line when there is no such file."""
     if not path.is_file():
         raise SpecError(str(path), None, "file", "no such file")
     packages = PackageMap(path, tuple(package_dirs), tuple(options.allow_read))
-    shell = Source(path, None, packages, report)
-    return READERS[kind_of(path)](shell, options)
+    return Source(path, None, packages, report)

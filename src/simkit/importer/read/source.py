@@ -4,12 +4,12 @@ Errors are one line each, naming the file, the line and the element (`errors.Spe
 Messy but common forms are read leniently, one report line each (`Source.lenient`), and
 refused with `--strict` (docs/importing.md, "Lenient reading"). The report is the one
 diagnostic channel of the read (Drake's DiagnosticPolicy); a PackageMap owns paths. The
-readers that make a Source, one per format, are in read/__init__.py's table.
+readers that make a Source, one per format, are in importer/formats (one table).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from simkit.errors import SpecError
@@ -23,12 +23,31 @@ __all__ = ["MissingMesh", "Position", "Source", "describe", "line_of", "resolve_
 @dataclass
 class Source:
     """The parsed document: its root element, where it came from, how to find packages,
-    and the report its lenient readings go to (None: refuse them)."""
+    and the report its lenient readings go to (None: refuse them). A format's reader
+    (importer/formats) fills the rest: `format` (its row in formats.FORMATS), `kept` (the
+    document as read, before any repair or rewrite: what the kit is compared with),
+    `original` and `args` (the imported file's digest, the --xacro-arg values), `base`
+    ((floating, why) when the format itself says whether the base floats, an MJCF's free
+    joint) and `scratch` (folders the translation reads from, removed after the import)."""
 
     path: Path
     root: object  # lxml.etree._Element
     packages: PackageMap
     report: Report | None = None
+    format: str = ""
+    #: SHA-256 of the file the user imported, and the --xacro-arg values read with it
+    original: str = ""
+    args: dict[str, str] = field(default_factory=dict)
+    kept: Source | None = None
+    base: tuple[bool, str] | None = None
+    scratch: list[Path] = field(default_factory=list)
+    #: the format's own word for the file, in report lines ("URDF", "MJCF")
+    noun: str = "URDF"
+
+    @property
+    def a_noun(self) -> str:
+        """The noun with its article as it is spoken ("a URDF", "an MJCF")."""
+        return f"{'an' if self.noun[:1] in 'AEFHILMNORSX' else 'a'} {self.noun}"
 
     def fail(self, element, message: str) -> SpecError:
         """A one-line error at `element` (file, line, element tag and name): the refusal of

@@ -156,7 +156,8 @@ def decide(source: Source) -> tuple[bool, str]:
     root = tree(source)[2]
     if len(found) >= 2 and _bolted(source):
         return False, (
-            f"fixed base: the URDF bolts the robot to '{root}' with a fixed joint ({figures}); "
+            f"fixed base: the {source.noun} bolts the robot to '{root}' with a fixed joint "
+            f"({figures}); "
             "--floating-base lets it move"
         )
     if len(found) >= 2:

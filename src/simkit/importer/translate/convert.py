@@ -270,7 +270,7 @@ def _visual_collision(source: Source, spec_links: list[dict], report: Report) ->
         report.estimated(
             source,
             source.root,
-            f"no <collision> in the URDF: {done} links collide with their visual solid's "
+            f"no <collision> in the {source.noun}: {done} links collide with their visual solid's "
             "convex hull (a floating base needs something to stand on)",
         )
 
@@ -283,7 +283,7 @@ def _estimated_solids(source: Source, links: list[dict], joints: list[dict], rep
         report.estimated(
             source,
             source.root,
-            f"no <visual> or <collision> in the URDF: {done} links with a mass get a box "
+            f"no <visual> or <collision> in the {source.noun}: {done} links with a mass get a box "
             f"spanning their origin, child joints and CoM, as thick as holds the mass at "
             f"{DENSITY:g} kg/m^3 up to {MAX_SIDE:g} m (solid and collision; a floating base "
             "needs something to stand on)",
@@ -351,7 +351,7 @@ def _report_mid_range(source: Source, movable: list[dict], home: dict, report: R
                 source,
                 source.root if element is None else element,
                 f"home: {home[j['name']]:.4g}, the middle of its range {j['lower']:.4g} .. "
-                f"{j['upper']:.4g} (the URDF's zero pose is outside it)",
+                f"{j['upper']:.4g} (the {source.noun}'s zero pose is outside it)",
             )
 
 

@@ -30,7 +30,7 @@ def joint_spec(source: Source, joint, report: Report, load: tuple[float, float])
         raise source.fail(joint, "a joint needs <parent link=...> and <child link=...>")
     for element in joint:
         if isinstance(element.tag, str) and element.tag not in KNOWN:
-            report.dropped(source, element, "not a URDF joint element simkit keeps")
+            report.dropped(source, element, f"not {source.a_noun} joint element simkit keeps")
     xyz, rpy = origin(source, joint)
     spec: dict = {
         "name": name,

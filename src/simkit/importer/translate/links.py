@@ -51,7 +51,8 @@ def inertial(source: Source, link, report: Report) -> dict:
         report.estimated(
             source,
             link,
-            f"no positive mass in the URDF: {MASSLESS_MASS} kg, inertia {MASSLESS_INERTIA} kg m^2",
+            f"no positive mass in the {source.noun}: {MASSLESS_MASS} kg, inertia "
+            f"{MASSLESS_INERTIA} kg m^2",
         )
         i = MASSLESS_INERTIA
         return {
@@ -59,7 +60,8 @@ def inertial(source: Source, link, report: Report) -> dict:
             "com": [0.0, 0.0, 0.0],
             "inertia": {"ixx": i, "iyy": i, "izz": i},
             "estimated": ["mass", "com", "inertia"],
-            "note": "massless in the URDF; a small mass keeps MuJoCo's moving bodies valid",
+            "note": f"massless in the {source.noun}; a small mass keeps MuJoCo's moving bodies "
+            "valid",
         }
     mass = floats(source, element.find("mass"), "value", 1)
     xyz, rpy = origin(source, element)
@@ -105,7 +107,8 @@ def inertial(source: Source, link, report: Report) -> dict:
         report.estimated(source, tag, f"{problem}: balanced (inertia_decision)")
         out["inertia_decision"] = {
             "action": "balance",
-            "reason": f"the URDF's inertia is not physical ({problem}); imported as given, "
+            "reason": f"the {source.noun}'s inertia is not physical ({problem}); imported as "
+            "given, "
             "the kit carries the balanced tensor",
         }
     return out
@@ -143,7 +146,7 @@ def link_spec(
         spec.update(inertial(source, link, report))
     for child in link:
         if isinstance(child.tag, str) and child.tag not in KNOWN:
-            report.dropped(source, child, "not a URDF link element simkit keeps")
+            report.dropped(source, child, f"not {source.a_noun} link element simkit keeps")
     visuals, rgba = [], None
     for visual in link.findall("visual"):
         got = shape_of(source, visual, writer, report, "visual")
@@ -207,7 +210,8 @@ def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dic
     report.estimated(
         source,
         link,
-        f"no mass in the URDF: {mass:.4g} kg, its visual solid's volume ({volume:.4g} m^3, "
+        f"no mass in the {source.noun}: {mass:.4g} kg, its visual solid's volume "
+        f"({volume:.4g} m^3, "
         f"{what}) at {density:g} kg/m^3 (--density); CoM and inertia of that solid",
     )
     flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
@@ -217,7 +221,7 @@ def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dic
         "com": [float(f"{c:.6g}") + 0.0 for c in com],
         "inertia": {k: float(f"{v:.9g}") + 0.0 for k, v in zip(keys, flat, strict=True)},
         "estimated": ["mass", "com", "inertia"],
-        "note": f"massless in the URDF; mass of its visual solid at {density:g} kg/m^3",
+        "note": f"massless in the {source.noun}; mass of its visual solid at {density:g} kg/m^3",
     }
 
 

@@ -1,6 +1,7 @@
 """Write: the draft's spec as YAML (the report as a comment header, then the spec,
-deterministic), validated once, moved into the output folder with its meshes (output.py), the
-source kept beside it (provenance.py); a refusal names the source element (located.py)."""
+deterministic), validated once, moved into the output folder with its meshes and the kept
+source the format wrote into the staging folder (output.py); a refusal names the source
+element (located.py)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from pathlib import Path
 import yaml
 
 from simkit.importer.draft import Draft
-from simkit.importer.write import located, provenance
+from simkit.importer.write import located
 from simkit.importer.write.output import publish
 from simkit.kitio.oneline import one_line
 
@@ -41,10 +42,10 @@ _Dumper.add_representer(tuple, _list)
 _Dumper.add_representer(dict, _dict)
 
 
-def spec_yaml(spec: dict, lines: list[str], source: Path) -> str:
+def spec_yaml(spec: dict, lines: list[str], source: Path, noun: str = "URDF") -> str:
     """The spec text: a header naming the source and each report line, then the spec."""
     head = [
-        f"# Imported from {one_line(source.name)} by `simkit import`. Numbers are the URDF's; "
+        f"# Imported from {one_line(source.name)} by `simkit import`. Numbers are the {noun}'s; "
         "values it",
         "# lacks are filled, listed under `estimated` and reported here:",
     ]
@@ -63,10 +64,10 @@ def finish(draft: Draft, out_dir: Path) -> Path:
     """Write the draft's spec once, validate it once (`check`), and copy it with its meshes
     from the staging folder into `out_dir`; a mesh the spec written there before used and
     this one does not is removed (no stale meshes). Returns the spec's path in `out_dir`."""
-    provenance.keep(draft)
     name = draft.spec["name"]
     staged = draft.stage / f"{name}.yaml"
-    staged.write_text(spec_yaml(draft.spec, draft.report.lines, draft.path), encoding="utf-8")
+    text = spec_yaml(draft.spec, draft.report.lines, draft.path, draft.source.noun)
+    staged.write_text(text, encoding="utf-8")
     check(staged, draft)
     target = out_dir / f"{name}.yaml"
     new = {item.relative_to(draft.stage) for item in draft.stage.rglob("*") if item.is_file()}
@@ -83,7 +84,8 @@ def refuse(draft: Draft) -> None:
     steps cannot resolve (draft.Unresolvable: a mass of 1e308) stops in one line, not deep
     in a fix-up."""
     staged = draft.stage / f"{draft.spec['name']}.yaml"
-    staged.write_text(spec_yaml(draft.spec, draft.report.lines, draft.path), "utf-8")
+    text = spec_yaml(draft.spec, draft.report.lines, draft.path, draft.source.noun)
+    staged.write_text(text, "utf-8")
     located.check(staged, draft.spec, draft.source, draft.renames)
     raise RuntimeError("a spec the schema refused passed simkit's validation")
 

@@ -11,8 +11,8 @@ the robot's tree) is listed in `source_differences` with its reason.
 
 from __future__ import annotations
 
-from simkit.importer.read.mjcf import MjcfSource
-from simkit.importer.translate.mjcf import name_of
+from simkit.importer.formats.mjcf.reader import MjcfSource
+from simkit.importer.formats.mjcf.tree import name_of
 
 
 def carry(spec: dict, source: MjcfSource, renames: dict) -> list[tuple[str, str]]:

@@ -1,4 +1,10 @@
-"""Expand a xacro with the xacro package, safely unless the user trusts the file (issue 24).
+"""xacro: a `.xacro` (`.urdf.xacro`) file, expanded, then read and kept as a URDF (issue 24).
+
+The format's row (formats.FORMATS): `sniff` by the file's name, `read` expands it and reads
+the expansion as formats/urdf does (kept as read, then repaired), `keep` and `EDITS` are the
+URDF's (the kept source is the expansion, NAME.source.urdf).
+
+The expansion uses the xacro package, safely unless the user trusts the file.
 
 xacro's module functions are swapped for the duration of one expansion (its state is
 module-global, so expansions are serialised by a lock):
@@ -27,13 +33,14 @@ from pathlib import Path
 from xml.sax.saxutils import escape
 
 from simkit.errors import SpecError
+from simkit.importer.formats import urdf
+from simkit.importer.formats.urdf.parse import document
 from simkit.importer.read import lenient
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.packages import PackageMap
 from simkit.importer.read.safe_eval import BUILTINS, MATH, MAX_WORK, Evaluator, Refused
 from simkit.importer.read.source import Source
-from simkit.importer.read.urdf import document
 
 #: nested macro calls
 MAX_MACRO_DEPTH = 100
@@ -278,7 +285,23 @@ class _Run:
         return self.original["handle_macro_call"](node, macros, symbols)
 
 
+def sniff(path: Path, head: bytes) -> bool:
+    """A xacro by its name: `.xacro` (`.urdf.xacro` included)."""
+    return path.suffix == ".xacro" or path.name.endswith(".urdf.xacro")
+
+
+def title(head: bytes) -> str | None:
+    """The file's name names the robot (None)."""
+    return None
+
+
 def read(shell: Source, options: ReadOptions) -> Source:
     """`shell` (path and PackageMap, no root yet) with its xacro expanded (`expand`) and the
-    expansion parsed as a URDF."""
-    return document(shell, expand(shell.path, shell.packages, options, shell))
+    expansion parsed, kept and repaired as a URDF (formats/urdf)."""
+    return urdf.repaired(document(shell, expand(shell.path, shell.packages, options, shell)))
+
+
+NOUN = urdf.NOUN
+keep = urdf.keep
+EDITS = urdf.EDITS
+AFTER = urdf.AFTER

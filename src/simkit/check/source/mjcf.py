@@ -13,9 +13,9 @@ A difference passes only when robot.json's `source_differences` lists it (key as
 `joints.J.axis`, `links.B.mass`, ...). The source's other files (includes, meshes) are read
 beside the given MODEL.xml, else from the kit source's `NAME.source.assets/SHA256.EXT`,
 each checked against its recorded digest; a source that is not the file the import read
-(its digest differs: check/source.py fails it) is never compiled. Frames: the kit's link
+(its digest differs: check/source/shared.py fails it) is never compiled. Frames: the kit's link
 frame of a body is the body frame moved by its last hinge or ball joint's `pos` (body
-axes), as the import defines it (importer/translate/mjcf.py); this check computes that rule
+axes), as the import defines it (importer/formats/mjcf/tree.py); this check computes that rule
 independently.
 """
 
@@ -27,9 +27,10 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from simkit.check import source_usd
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.check.source import kit_usd as source_usd
+from simkit.check.source.shared import Allowed
 from simkit.kitio.oneline import one_line
 
 REL = 1e-6
@@ -42,22 +43,28 @@ SHOWN = 20
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 
 
-def compare(kit: Kit, allowed) -> list[Finding]:
-    """Findings for the MJCF source `kit.source` against the kit's MJCF; `allowed`:
-    check/source.py's Allowed (listed keys and renames)."""
+def remake(path: Path, args: dict[str, str]) -> bytes:
+    """The kept file made from the original: an MJCF is kept byte for byte."""
+    return path.read_bytes()
+
+
+def compare(kit: Kit, path: Path) -> list[Finding]:
+    """Findings for the MJCF source at `path` against the kit's MJCF, differences
+    allowed where robot.json lists them (shared.Allowed: listed keys and renames)."""
     import mujoco
 
+    allowed = Allowed.of(kit.doc)
     recorded = kit.doc.get("source") or {}
-    if hashlib.sha256(kit.source.read_bytes()).hexdigest() != recorded.get("sha256"):
+    if hashlib.sha256(path.read_bytes()).hexdigest() != recorded.get("sha256"):
         return []  # not the file the import read (source.digest fails): never compiled
     assets = recorded.get("assets") or {}
     with tempfile.TemporaryDirectory(prefix="simkit-source-") as tmp:
         folder = Path(tmp)
-        problems = _lay_out(kit.source, assets, folder)
+        problems = _lay_out(path, assets, folder)
         if problems:
             return [require("source.digest", False, p) for p in problems[:SHOWN]]
         try:
-            source = mujoco.MjSpec.from_file(str(folder / kit.source.name)).compile()
+            source = mujoco.MjSpec.from_file(str(folder / path.name)).compile()
         except Exception as exc:
             why = " ".join(str(exc).split())[:200]
             return [require("source.read", False, f"MuJoCo cannot compile the source: {why}")]

@@ -9,11 +9,11 @@ legal name and reports it, so that the kit builds; the kit's URDF carries the ne
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from types import SimpleNamespace
 from types import SimpleNamespace as NS
 
-from simkit.importer.diagnostics import Report
-from simkit.importer.read.source import Source
+from simkit.importer.draft import Draft
 from simkit.spec.names import MAX_NAME, problems
 
 #: spec keys holding link, joint or frame names: (list key, fields)
@@ -54,9 +54,10 @@ def _construct(spec: dict) -> dict:
     return out
 
 
-def make_legal(spec: dict, source: Source, report: Report) -> dict[str, dict[str, str]]:
+def make_legal(spec: dict, say: Callable[[str, str, str], None]) -> dict[str, dict[str, str]]:
     """Rename (in place, with every reference) the links, joints and frames whose names the
-    spec refuses; one `changed` line each at the URDF element. Returns {"links" | "joints" |
+    spec refuses; one `changed` line each at the source element (`say(tag, source name,
+    message)`: Draft.note_named). Returns {"links" | "joints" |
     "frames": {URDF name: spec name}} for what was renamed."""
     original: dict[str, str] = {}  # a renamed name -> the URDF's
     final: dict[str, dict[str, str]] = {}
@@ -85,8 +86,7 @@ def make_legal(spec: dict, source: Source, report: Report) -> dict[str, dict[str
             original[new] = urdf = original.get(old, old)
             final.setdefault(kind, {})[urdf] = new
             tag = "joint" if kind == "joints" else "link"
-            element = next((e for e in source.root.iter(tag) if e.get("name") == urdf), None)
-            report.changed(source, element, f"renamed to '{new}' ({why})")
+            say(tag, urdf, f"renamed to '{new}' ({why})")
         _apply(spec, renames)
     return final
 
@@ -108,3 +108,9 @@ def _apply(spec: dict, renames: dict[str, dict[str, str]]) -> None:
     for key in ("root", "tool_frame", "wrist_centre"):
         if key in spec:
             spec[key] = links.get(spec[key], spec[key])
+
+
+def legal(draft: Draft) -> None:
+    """The import's step: the draft's names made legal (`make_legal`), its renames kept."""
+    draft.renames = make_legal(draft.spec, draft.note_named)
+    draft.changed()

@@ -1,10 +1,11 @@
-"""Where the kit came from and where it differs: the last step of an import.
+"""Where the kit came from and where it differs, shared by the formats' `keep`.
 
-The import keeps the expanded source URDF beside the spec (`NAME.source.urdf`, the document
-the importer read, xacro expanded, comments dropped), records its SHA-256 in the spec's
-`source`, and lists every intended difference between the kit and that source in
-`source_differences`, each with its reason. The build's source check (check/source.py)
-re-reads the kept file with yourdfpy and fails on any difference not listed. Keys use the
+Each format keeps its source beside the spec (formats/urdf: `NAME.source.urdf`, the
+document the importer read, xacro expanded, comments dropped; formats/mjcf: the model and
+its files), records its SHA-256 in the spec's `source`, and lists every intended difference
+between the kit and that source in `source_differences`, each with its reason
+(`differences`, here). The build's source check (check/source) re-reads the kept file with
+a reader other than the importer's and fails on any difference not listed. Keys use the
 URDF's names: `links.L.FIELD`, `joints.J.FIELD`, `links.L.name` (renamed, `kit` = new name),
 `links.NAME` / `joints.NAME` (added by the kit).
 """
@@ -15,9 +16,7 @@ import hashlib
 from dataclasses import replace
 
 from simkit.importer.diagnostics import Report
-from simkit.importer.read.mjcf import MjcfSource
 from simkit.importer.read.source import Source, describe, line_of
-from simkit.importer.write import mjcf_source
 from simkit.kitio.oneline import one_line
 from simkit.spec.bounds import MAX_STRING
 
@@ -37,46 +36,26 @@ GENERIC = {
 }
 
 
-def source_name(spec: dict) -> str:
-    """The kept source's file name, beside the spec."""
-    return f"{spec['name']}.source.urdf"
+def entry(draft, name: str, data: bytes) -> dict:
+    """The spec's `source` entry of a kept file `name` holding `data`: its digest, the
+    format, and the original's digest and the --xacro-arg values where they matter (the
+    kept file is not the original byte for byte; the file was read with arguments)."""
+    source = draft.source
+    out = {"file": name, "format": source.format, "sha256": hashlib.sha256(data).hexdigest()}
+    if source.original and source.original != out["sha256"]:
+        out["original"] = source.original
+    if source.args:
+        out["args"] = dict(sorted(source.args.items()))
+    return out
 
 
 def as_read(source: Source) -> Source:
-    """The URDF as the importer read it (xacro expanded), copied before any rewrite (a
-    spherical joint becomes three joints in place, ball_joints.py): what the kit is
-    compared with. Line numbers are kept, so report lines still match its elements."""
+    """The document as the importer read it (xacro expanded), copied before any repair or
+    rewrite (a spherical joint becomes three joints in place, ball_joints.py): what the kit
+    is compared with. Line numbers are kept, so report lines still match its elements."""
     import copy
 
     return replace(source, root=copy.deepcopy(source.root))
-
-
-def keep(draft) -> None:
-    """Write the kept source into the draft's staging folder and add `source` and
-    `source_differences` to its spec (the last step before write.finish writes it)."""
-    from lxml import etree
-
-    original = draft.kept
-    if isinstance(original, MjcfSource):  # the MJCF as read and its files (mjcf_source.py)
-        mjcf_source.refuse_falling(draft, original)
-        spec = draft.spec
-        spec["source"] = mjcf_source.keep(draft, original)
-        listed = differences(spec, original, draft.report, draft.renames)
-        extra = [{"what": one_line(w), "reason": one_line(r)} for w, r in original.listed]
-        seen = {d["what"] for d in listed}
-        spec["source_differences"] = sorted(
-            listed + [d for d in extra if d["what"] not in seen], key=lambda d: d["what"]
-        )
-        draft.changed()
-        return
-    data = etree.tostring(original.root.getroottree(), xml_declaration=True, encoding="utf-8")
-    data = data.rstrip(b"\n") + b"\n"
-    spec = draft.spec
-    name = source_name(spec)
-    (draft.stage / name).write_bytes(data)
-    spec["source"] = {"file": name, "sha256": hashlib.sha256(data).hexdigest()}
-    spec["source_differences"] = differences(spec, original, draft.report, draft.renames)
-    draft.changed()
 
 
 def differences(
@@ -111,13 +90,15 @@ def differences(
             said = _said(records, source, element)
             for field in item.get("estimated", []):
                 if field in fields:
-                    add(f"{kind}.{old}.{field}", said or GENERIC[field])
+                    generic = GENERIC[field].replace("URDF", source.noun)
+                    add(f"{kind}.{old}.{field}", said or generic)
             if kind == "links" and element is not None:
                 _dropped(records, source, element, f"links.{old}", add)
             if kind == "links" and item.get("inertia_decision"):
                 add(f"links.{old}.inertia", item["inertia_decision"]["reason"])
             if kind == "joints" and element is not None and element.get("type") != item["type"]:
-                add(f"joints.{old}.type", said or f"a {element.get('type')} joint in the URDF")
+                kind_in = f"a {element.get('type')} joint in the {source.noun}"
+                add(f"joints.{old}.type", said or kind_in)
     _massless(source, add)
     return [out[k] for k in sorted(out)]
 
@@ -133,7 +114,9 @@ def _massless(source: Source, add) -> None:
         except ValueError:
             massless = False
         if massless:
-            reason = "a massless link in the URDF: a body without mass has no CoM or inertia"
+            reason = (
+                f"a massless link in the {source.noun}: a body without mass has no CoM or inertia"
+            )
             add(f"links.{link.get('name')}.com", reason)
             add(f"links.{link.get('name')}.inertia", reason)
 
@@ -144,13 +127,15 @@ def _added(spec: dict, source: Source, back: dict[str, str], add) -> None:
     old = _quoted(back.get(root, root))
     if source.root.find(f"link[@name='{old}']") is not None:
         return  # the URDF's own massless root link is the kit's root
-    if source.root.find(f"joint/parent[@link='{old}']") is not None:  # translate/declare.py
-        add(f"links.{root}", "added: the frame the URDF mounts the robot on, named, not declared")
+    if source.root.find(f"joint/parent[@link='{old}']") is not None:  # formats/urdf/repairs.py
+        said = f"added: the frame the {source.noun} mounts the robot on, named, not declared"
+        add(f"links.{root}", said)
         return
     for joint in spec["joints"]:
         if joint["parent"] == root and joint["type"] == "fixed":
             add(f"links.{root}", "added: the world the fixed base is bolted to")
-            add(f"joints.{joint['name']}", "added: bolts the URDF's root link to the world")
+            said = f"added: bolts the {source.noun}'s root link to the world"
+            add(f"joints.{joint['name']}", said)
 
 
 #: joint fields the source check compares, listed for a joint the kit had to reshape
@@ -165,7 +150,9 @@ def _reshaped(spec: dict, source: Source, report: Said, back: dict[str, str], ad
     for element in source.root.findall("joint"):  # the robot's joints, not a block's
         if element.get("type") in kinds or not element.get("name"):
             continue
-        said = _said(report, source, element) or f"a {element.get('type')} joint in the URDF"
+        said = _said(report, source, element) or (
+            f"a {element.get('type')} joint in the {source.noun}"
+        )
         name = element.get("name")
         for field in RESHAPED:
             add(f"joints.{name}.{field}", said)

@@ -9,7 +9,7 @@ texture, hfield or skin `file`, the compiler's folders) is checked to resolve in
 model's folder, and the files' sizes and the element count are capped; a refusal is one line
 naming the file, the line and the element. The files read are kept (`MjcfSource.files`,
 paths relative to the model's folder) with their bytes, for the kept source and its digests
-(write/provenance.py).
+(kept.py).
 """
 
 from __future__ import annotations
@@ -42,47 +42,18 @@ DIR_ATTRS = ("meshdir", "texturedir", "assetdir")
 class MjcfSource(Source):
     """A read MJCF: the compiled `model` (mujoco.MjModel) and its `spec` (mujoco.MjSpec);
     `files`: every file it read, relative to the model's folder -> bytes. `root` is filled
-    by translate/mjcf.py with the URDF-shaped tree the shared translation takes."""
+    by tree.py with the URDF-shaped tree the shared translation takes."""
 
     model: object = None
     spec: object = None
     files: dict[str, bytes] = field(default_factory=dict)
-    #: (what, reason) of each element a kit cannot carry (translate/mjcf_listed.py)
+    #: (what, reason) of each element a kit cannot carry (listed.py)
     listed: list[tuple[str, str]] = field(default_factory=list)
     #: (kind, compiled id) -> line in the model file of each body, geom, jnt and site
     #: (`lines`): the report's records name it
     lines: dict[tuple[str, int], int] = field(default_factory=dict)
     #: the keys of `lines` that are an `<include>`'s line (shared by what it brings in)
     included: set[tuple[str, int]] = field(default_factory=set)
-
-
-def _head(path: Path) -> bytes | None:
-    """The file's first 64 KiB without comments and processing instructions, or None."""
-    try:
-        with path.open("rb") as handle:
-            head = handle.read(65536)
-    except OSError:
-        return None
-    head = re.sub(rb"<!--.*?-->", b"", head, flags=re.S)
-    return re.sub(rb"<\?.*?\?>", b"", head, flags=re.S)
-
-
-def is_mjcf(path: Path) -> bool:
-    """Whether the file's root element is `<mujoco>` (read from its first 64 KiB)."""
-    head = _head(path)
-    return head is not None and re.match(rb"\s*<\s*mujoco[\s>/]", head) is not None
-
-
-def model_name(path: Path) -> str | None:
-    """The `<mujoco model="...">` attribute (from the file's first 64 KiB), or None: the
-    name a model's authors gave it, where robot collections name every file `robot.xml`."""
-    head = _head(path)
-    found = (
-        None
-        if head is None
-        else re.search(rb"<\s*mujoco\b[^>]*?\bmodel\s*=\s*([\"'])([^\"']*)\1", head)
-    )
-    return found.group(2).decode("utf-8", "replace") if found else None
 
 
 def read(shell: Source, options: ReadOptions) -> MjcfSource:

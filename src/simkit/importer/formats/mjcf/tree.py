@@ -1,4 +1,4 @@
-"""A compiled MJCF (read/mjcf.py) to the URDF-shaped tree the shared translation takes.
+"""A compiled MJCF (formats/mjcf/reader.py) to the URDF-shaped tree the shared translation takes.
 
 MuJoCo has compiled the model, so every number here is the simulator's: bodies are links
 (inertial from the compiled model: mass, CoM, principal inertia and its axes), hinge ->
@@ -11,8 +11,8 @@ written as STL. The shared translation (convert.py) then makes the spec exactly 
 Frames: a URDF joint turns about its child link's origin, an MJCF joint about its own `pos`
 in the body. A body's link frame is therefore its body frame moved by `offset` (the last
 hinge or ball joint's `pos`, body axes; 0 without one); the source check applies the same
-rule (check/source_mjcf.py). Several joints in one body become a chain through added
-massless links `JOINT_link`. What a kit cannot carry is listed (mjcf_listed.py).
+rule (check/source/mjcf.py). Several joints in one body become a chain through added
+massless links `JOINT_link`. What a kit cannot carry is listed (listed.py).
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from simkit.errors import SpecError
-from simkit.importer.read.mjcf import MjcfSource
-from simkit.importer.translate import mjcf_listed
+from simkit.importer.formats.mjcf import listed as mjcf_listed
+from simkit.importer.formats.mjcf.reader import MjcfSource
 
 #: mjtJoint: free, ball, slide, hinge; mjtGeom
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
@@ -129,7 +129,7 @@ def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple
 
 def _lines(robot, source: MjcfSource, root_body: int) -> None:
     """Each element's `sourceline`: the MJCF line of the body, joint, geom or site it comes
-    from (read/mjcf.py `lines`, recorded in the `mjcf` attribute as KIND:ID), else its
+    from (reader.py `lines`, recorded in the `mjcf` attribute as KIND:ID), else its
     parent element's; the `<robot>` the root body's. The report's records name it, and
     provenance finds an element's records by line and element: so an element without a
     name (a visual, a joint's limit) brought in by an `<include>`, whose line all it brings
@@ -279,7 +279,7 @@ def _kind(joint, model, j: int, kind: int) -> None:
 def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
     """Each geom of the body: a `<visual>` when it collides with nothing (contype =
     conaffinity = 0), else a `<collision>`; shapes the URDF form has no word for are listed
-    by mjcf_listed.py."""
+    by listed.py."""
     from lxml import etree
 
     for g in range(
@@ -289,7 +289,7 @@ def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
         if kind not in (SPHERE, CAPSULE, CYLINDER, BOX, MESH) or (
             kind == MESH and mjcf_listed.flat(model, int(model.geom_dataid[g]))
         ):
-            continue  # listed (mjcf_listed.py)
+            continue  # listed (listed.py)
         tag = (
             "visual"
             if model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0

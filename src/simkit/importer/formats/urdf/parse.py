@@ -15,7 +15,7 @@ from simkit.importer.read import lenient
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
-from simkit.spec.urdf_blocks import TAGS  # kept verbatim (translate/blocks.py)
+from simkit.spec.urdf_blocks import TAGS  # kept verbatim (formats/urdf/blocks.py)
 
 
 def read(shell: Source, options: ReadOptions) -> Source:

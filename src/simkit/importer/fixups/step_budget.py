@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.importer.draft import Draft
+
 #: Visual mesh triangles a kit's STEP can hold: about 46 MB of faceted STEP.
 MAX_TRIANGLES = 20_000
 
@@ -55,3 +57,13 @@ def step_fits(spec: dict, spec_dir: Path) -> tuple[bool, str]:
         f"no STEP assembly (spec step: false): the visual meshes hold {count:,} triangles, a "
         f"faceted STEP of about {megabytes:,.0f} MB (limit {MAX_TRIANGLES:,} triangles)"
     )
+
+
+def fit(draft: Draft) -> None:
+    """The import's step: the STEP left out (`step: false`, one report line) when the
+    visual meshes are too large for one (`step_fits`)."""
+    fits, why = step_fits(draft.spec, draft.stage)
+    if not fits:
+        draft.spec["step"] = False
+        draft.note_change(why)
+        draft.changed()

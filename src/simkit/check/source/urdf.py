@@ -1,7 +1,8 @@
-"""The kit is the robot it was imported from: re-read the source URDF with an independent
-reader (yourdfpy, not the importer's lxml walk) and compare its kinematics, limits and mass
-properties with the kit's written URDF. Every difference must be listed, with its reason, in
-robot.json's `source_differences`; any other fails, naming the joint or link.
+"""The kit is the URDF (or xacro) robot it was imported from: re-read the source URDF with
+an independent reader (yourdfpy, not the importer's lxml walk) and compare its kinematics,
+limits and mass properties with the kit's written URDF. Every difference must be listed,
+with its reason, in robot.json's `source_differences`; any other fails, naming the joint or
+link.
 
 Names: `what` keys use the source's names (`joints.J.axis`, `links.L.mass`); a renamed
 element is `links.L.name` / `joints.J.name` with the kit's name in `kit`; an element the kit
@@ -11,48 +12,16 @@ Units: m, rad, kg, kg m^2, all in the link or joint frame the URDF defines.
 
 from __future__ import annotations
 
-import hashlib
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from simkit.check import source_mjcf, source_usd
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.check.source import kit_usd as source_usd
+from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed
 from simkit.kitio.oneline import one_line
-
-#: relative tolerance: the kit carries 10 significant digits (kitio/fmt.py); a hand-typed
-#: source rarely more. Far below any real change (an axis turned, a mass 10 % off).
-REL = 1e-6
-#: m: absolute floor for lengths; kg m^2 floor for inertia terms is REL x the largest moment
-ABS_LENGTH = 1e-9
-#: failures named per finding category before "and N more"
-SHOWN = 20
-
-
-@dataclass
-class Allowed:
-    """robot.json's `source_differences`: allowed keys and the source -> kit renames."""
-
-    keys: set[str] = field(default_factory=set)
-    links: dict[str, str] = field(default_factory=dict)
-    joints: dict[str, str] = field(default_factory=dict)
-
-    @staticmethod
-    def of(doc: dict) -> Allowed:
-        """From robot.json (or any dict with `source_differences`)."""
-        out = Allowed()
-        for item in doc.get("source_differences", []):
-            what = str(item.get("what", ""))
-            out.keys.add(what)
-            kind, _, rest = what.partition(".")
-            name, _, attr = rest.rpartition(".")
-            if attr == "name" and isinstance(item.get("kit"), str) and kind in ("links", "joints"):
-                getattr(out, kind)[name] = item["kit"]
-        return out
-
 
 #: attributes holding numbers that the comparison reads (origins, axes, limits, inertials)
 NUMERIC = {"xyz", "rpy", "value", "lower", "upper", "effort", "velocity", "damping", "friction"}
@@ -123,19 +92,39 @@ def load_urdf(path: Path, fixes: list[str] | None = None):
     ).robot
 
 
-def check_source(kit: Kit) -> list[Finding]:
-    """The comparison, when the build or `simkit check --source` gave a source file; no
-    findings otherwise (a hand-written spec has no source)."""
-    if kit.source is None:
-        return []
-    findings = _digest(kit, kit.source)
-    if kit.source.suffix.lower() == ".xml":  # an MJCF: MuJoCo compiles both (source_mjcf.py)
-        return findings + source_mjcf.compare(kit, Allowed.of(kit.doc))
+def _read_leniently(path: Path) -> tuple[object | None, list[str]]:
+    """(yourdfpy's robot of the source read leniently, the fixes applied), or (None, ...)
+    when no fix applies or yourdfpy still cannot read it."""
+    fixes: list[str] = []
     try:
-        source = load_urdf(kit.source)
+        robot = load_urdf(path, fixes)
+    except Exception:  # yourdfpy raises several types on bad input
+        return None, fixes
+    return (robot if fixes else None), fixes
+
+
+def remake(path: Path, args: dict[str, str]) -> bytes:
+    """The kept URDF made anew from the original file the user imported (a URDF, or a xacro
+    expanded with the import's `args`), read by the importer's reader as the import read it
+    (formats/urdf.py `serialised`); SpecError when it cannot be read."""
+    from simkit.importer import formats
+    from simkit.importer.diagnostics import Report
+    from simkit.importer.formats import urdf as urdf_format
+    from simkit.importer.read.options import ReadOptions
+
+    doc = formats.load(path, (), Report(), ReadOptions(tuple(sorted(args.items()))))
+    return urdf_format.serialised(doc.kept)
+
+
+def compare(kit: Kit, path: Path) -> list[Finding]:
+    """The comparison of the URDF source at `path` (yourdfpy) with the kit's URDF, and of
+    the source with the kit's USD (kit_usd.py)."""
+    findings: list[Finding] = []
+    try:
+        source = load_urdf(path)
     except Exception as exc:  # yourdfpy raises several types on bad input
         why = " ".join(str(exc).split())[:200]
-        source, fixes = _read_leniently(kit.source)
+        source, fixes = _read_leniently(path)
         if source is None:
             fail = f"yourdfpy cannot read the source: {why}"
             return [*findings, require("source.read", False, fail)]
@@ -152,35 +141,6 @@ def check_source(kit: Kit) -> list[Finding]:
     allowed = Allowed.of(kit.doc)
     usd = source_usd.compare(kit, source_usd.source_of_urdf(source), allowed)
     return findings + compare_robots(source, built, allowed) + usd
-
-
-def _read_leniently(path: Path) -> tuple[object | None, list[str]]:
-    """(yourdfpy's robot of the source read leniently, the fixes applied), or (None, ...)
-    when no fix applies or yourdfpy still cannot read it."""
-    fixes: list[str] = []
-    try:
-        robot = load_urdf(path, fixes)
-    except Exception:  # yourdfpy raises several types on bad input
-        return None, fixes
-    return (robot if fixes else None), fixes
-
-
-def _digest(kit: Kit, path: Path) -> list[Finding]:
-    """The source file is the one the import recorded (robot.json `source.sha256`)."""
-    recorded = (kit.doc.get("source") or {}).get("sha256")
-    if recorded is None:
-        return []
-    actual = hashlib.sha256(path.read_bytes()).hexdigest()
-    return [
-        require(
-            "source.digest",
-            actual == recorded,
-            f"{path.name} is the file the import recorded (sha256 {recorded[:12]}...)"
-            if actual == recorded
-            else f"{path.name} was changed after the import: sha256 {actual[:12]}..., "
-            f"robot.json records {recorded[:12]}...",
-        )
-    ]
 
 
 def compare_robots(source, built, allowed: Allowed) -> list[Finding]:

@@ -5,7 +5,7 @@ A kit carries a robot's links, joints, frames, geometry and one servo per joint;
 tendons, equality constraints, cameras, lights, keyframes, sensors, contact pairs,
 actuators that drive anything but one joint, and its own servo gains have no place in the
 spec. Each is listed with its reason (key `KIND.NAME`), never dropped silently. Contact
-excludes are carried (mjcf_excludes.py).
+excludes are carried (excludes.py).
 """
 
 from __future__ import annotations

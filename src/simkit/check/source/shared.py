@@ -1,0 +1,82 @@
+"""What every format's source proof shares: robot.json's listed differences (`Allowed`),
+the tolerances, and the identity of the given source file (`digest`): the kept copy, or
+the original the user imported."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from simkit.check.findings import Finding, require
+from simkit.check.kit import Kit
+from simkit.errors import SimkitError
+from simkit.kitio.oneline import one_line
+
+#: relative tolerance: the kit carries 10 significant digits (kitio/fmt.py); a hand-typed
+#: source rarely more. Far below any real change (an axis turned, a mass 10 % off).
+REL = 1e-6
+#: m: absolute floor for lengths; kg m^2 floor for inertia terms is REL x the largest moment
+ABS_LENGTH = 1e-9
+#: failures named per finding category before "and N more"
+SHOWN = 20
+
+
+@dataclass
+class Allowed:
+    """robot.json's `source_differences`: allowed keys and the source -> kit renames."""
+
+    keys: set[str] = field(default_factory=set)
+    links: dict[str, str] = field(default_factory=dict)
+    joints: dict[str, str] = field(default_factory=dict)
+
+    @staticmethod
+    def of(doc: dict) -> Allowed:
+        """From robot.json (or any dict with `source_differences`)."""
+        out = Allowed()
+        for item in doc.get("source_differences", []):
+            what = str(item.get("what", ""))
+            out.keys.add(what)
+            kind, _, rest = what.partition(".")
+            name, _, attr = rest.rpartition(".")
+            if attr == "name" and isinstance(item.get("kit"), str) and kind in ("links", "joints"):
+                getattr(out, kind)[name] = item["kit"]
+        return out
+
+
+def digest(kit: Kit, path: Path, remake) -> tuple[list[Finding], bytes]:
+    """The given file is the one the import kept (robot.json `source.sha256`) or the one
+    the user imported (`source.original`: a URDF or xacro, made into the kept file again by
+    `remake(path, args)`, which must give the kept digest). Returns the finding and the
+    bytes to compare the kit with (the given file's, unless it is the original)."""
+    recorded = kit.doc.get("source") or {}
+    data = path.read_bytes()
+    actual = hashlib.sha256(data).hexdigest()
+    kept, original = recorded.get("sha256"), recorded.get("original")
+    if kept is None:
+        return [], data
+    if actual == kept:
+        said = f"{path.name} is the file the import recorded (sha256 {kept[:12]}...)"
+        return [require("source.digest", True, said)], data
+    if actual != original:
+        said = (
+            f"{path.name} was changed after the import: sha256 {actual[:12]}..., robot.json "
+            f"records {kept[:12]}...{f' (the original {original[:12]}...)' if original else ''}"
+        )
+        return [require("source.digest", False, said)], data
+    try:
+        made = remake(path, dict(recorded.get("args") or {}))
+    except SimkitError as exc:
+        said = f"{path.name} is the imported file, but it no longer reads: {exc}"
+        return [require("source.digest", False, one_line(said))], data
+    if hashlib.sha256(made).hexdigest() != kept:
+        said = (
+            f"{path.name} is the imported file (sha256 {actual[:12]}...), but it does not read "
+            "as the import read it (a file it includes, or the environment, changed)"
+        )
+        return [require("source.digest", False, said)], data
+    said = (
+        f"{path.name} is the file the user imported (sha256 {actual[:12]}...); read as the "
+        f"import read it, it gives the kept file (sha256 {kept[:12]}...)"
+    )
+    return [require("source.digest", True, said)], made

@@ -1,0 +1,108 @@
+"""The formats an import reads: one module (or package) per format, one row each in `FORMATS`.
+
+Each format gives:
+- `sniff(path, head)`: whether the file is of this format (`head`: its first 64 KiB without
+  comments and processing instructions, read once by `pick` for every format);
+- `title(head)`: the name the file gives its robot, or None (the spec's default name);
+- `read(shell, options)`: the read `Source` (importer/read/source.py), the one model every
+  format gives the translation, with `kept` (the document as read) and `format` set;
+- `keep(draft)`: the kept source written beside the spec and the spec's `source` and
+  `source_differences` (formats/provenance.py);
+- `edits` and `after`: the format's own draft steps, run right after the translation
+  (before the shared fix-ups) and after them (importer.steps).
+
+`pick` chooses the format once, from the first row whose `sniff` accepts the file; the URDF
+row accepts every file, so it comes last. A new format is one module here and one row in
+`FORMATS`, plus one module and one row in check/source's `COMPARE` for its source proof.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from simkit.importer import read
+from simkit.importer.diagnostics import Report
+from simkit.importer.formats import mjcf, urdf, xacro
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.read.source import Source
+
+
+@dataclass(frozen=True)
+class Format:
+    """One row of `FORMATS`: a format's name and its functions (see the module's text)."""
+
+    name: str
+    sniff: Callable[[Path, bytes], bool]
+    title: Callable[[bytes], str | None]
+    read: Callable[[Source, ReadOptions], Source]
+    keep: Callable[[object], None]
+    noun: str = "URDF"
+    edits: tuple[Callable[[object], None], ...] = ()
+    after: tuple[Callable[[object], None], ...] = ()
+
+
+def _module_row(name: str, module) -> Format:
+    return Format(
+        name, module.sniff, module.title, module.read, module.keep, module.NOUN, module.EDITS,
+        module.AFTER,
+    )  # fmt: skip
+
+
+#: the formats, in the order `pick` tries them (the URDF, which takes any file, last)
+FORMATS: tuple[Format, ...] = (
+    _module_row("xacro", xacro),
+    _module_row("mjcf", mjcf),
+    _module_row("urdf", urdf),
+)
+BY_NAME = {f.name: f for f in FORMATS}
+
+
+def head(path: Path) -> bytes:
+    """The file's first 64 KiB without comments and processing instructions (b"" when it
+    cannot be read: the reader then says why, in one line)."""
+    try:
+        with path.open("rb") as handle:
+            data = handle.read(65536)
+    except OSError:
+        return b""
+    data = re.sub(rb"<!--.*?-->", b"", data, flags=re.S)
+    return re.sub(rb"<\?.*?\?>", b"", data, flags=re.S)
+
+
+@dataclass(frozen=True)
+class Picked:
+    """The format of a file and the name its file gives the robot (None: none given)."""
+
+    format: Format
+    title: str | None
+
+
+def pick(path: Path) -> Picked:
+    """The file's format, its head read once (the first row whose `sniff` accepts it)."""
+    first = head(path)
+    found = next(f for f in FORMATS if f.sniff(path, first))
+    return Picked(found, found.title(first))
+
+
+def load(
+    path: Path,
+    package_dirs: tuple[Path, ...] = (),
+    report: Report | None = None,
+    options: ReadOptions | None = None,
+    picked: Picked | None = None,
+) -> Source:
+    """Read `path` with its format's reader (`picked`, else `pick`); `report` takes the
+    lenient readings (None: they are refused, as with --strict)."""
+    options = options or ReadOptions()
+    source = read.shell(path, package_dirs, report, options)
+    fmt = (picked or pick(path)).format
+    done = fmt.read(source, options)
+    for doc in (done, done.kept):
+        doc.format, doc.noun = fmt.name, fmt.noun
+    done.original = hashlib.sha256(path.read_bytes()).hexdigest()
+    done.args = options.args()
+    return done

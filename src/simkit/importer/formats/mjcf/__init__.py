@@ -1,0 +1,113 @@
+"""MJCF: a MuJoCo model file (root element `<mujoco>`), read by MuJoCo itself (issue 31).
+
+- `read`: the file confined and bounded, compiled by MuJoCo (reader.py), then its robot
+  made the tree the shared translation takes (tree.py; meshes written as STL into a scratch
+  folder the import removes), the elements a kit cannot carry listed (listed.py), the base
+  floating where the root body has a free joint (`Source.base`), the tree kept as read;
+- `keep`: the model file byte for byte and every file it read (kept.py), and the
+  differences: the shared ones (formats/provenance.py) and the listed ones;
+- `EDITS`: the model's contact excludes carried into the spec (excludes.py);
+- `AFTER`: a free base that falls on the kit's servos is refused (fixups/falling.py).
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+import shutil
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+from simkit.errors import SpecError
+from simkit.importer.fixups import falling, settle
+from simkit.importer.formats import provenance
+from simkit.importer.formats.mjcf import excludes, kept, reader, tree
+from simkit.importer.formats.mjcf.reader import MjcfSource
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.read.source import Source
+from simkit.kitio.oneline import one_line
+
+#: the kit's own words for the source, in report lines and the spec's header
+NOUN = "MJCF"
+
+
+def sniff(path: Path, head: bytes) -> bool:
+    """Whether the file's root element is `<mujoco>` (its head, comments removed)."""
+    return re.match(rb"\s*<\s*mujoco[\s>/]", head) is not None
+
+
+def title(head: bytes) -> str | None:
+    """The `<mujoco model="...">` attribute, or None: the name a model's authors gave it,
+    where robot collections name every file `robot.xml`."""
+    found = re.search(rb"<\s*mujoco\b[^>]*?\bmodel\s*=\s*([\"'])([^\"']*)\1", head)
+    return found.group(2).decode("utf-8", "replace") if found else None
+
+
+def read(shell: Source, options: ReadOptions) -> MjcfSource:
+    """The model compiled by MuJoCo and its robot's tree, the base its free joint says,
+    the tree as read kept for the source differences."""
+    source = reader.read(shell, options)
+    scratch = Path(tempfile.mkdtemp(prefix="simkit-mjcf-"))
+    source.scratch.append(scratch)
+    try:
+        source.root, floating, source.listed = tree.to_tree(source, scratch)
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
+    source.packages.allow_read = (*source.packages.allow_read, scratch.resolve())
+    source.base = (
+        bool(floating),
+        "floating base: the MJCF's root body has a free joint; --fixed-base bolts it"
+        if floating
+        else "fixed base: the MJCF's root body has no free joint; --floating-base frees it",
+    )
+    source.kept = replace(source, root=copy.deepcopy(source.root))
+    return source
+
+
+def carry_excludes(draft) -> None:
+    """The model's contact excludes into the spec; those it cannot carry are listed."""
+    listed = excludes.carry(draft.spec, draft.source, draft.renames)
+    draft.kept.listed = [*draft.kept.listed, *listed]
+
+
+def refuse_falling(draft) -> None:
+    """One line when a floating MJCF robot does not stand on the kit's servos
+    (fixups/falling.py): the line names the construct, a free base that needs active
+    balance (and, where the MJCF drives its joints by torque `<motor>`s, says so), at the
+    free joint's line."""
+    drop = falling.sinks(draft)
+    if drop is None:
+        return
+    source = draft.kept
+    model = source.model
+    free = [j for j in range(model.njnt) if model.jnt_type[j] == 0]
+    motors = any(
+        model.actuator_gaintype[a] == 0 and model.actuator_biastype[a] == 0 for a in range(model.nu)
+    )
+    why = "torque <motor>s drive its joints; " if motors else ""
+    raise SpecError(
+        str(source.path), source.lines.get(("jnt", free[0])) if free else None, "freejoint",
+        f"a free base that needs active balance: on a kit's position servos at home it "
+        f"sinks {drop:.2f} m in {settle.SECONDS:g} s ({why}a kit carries no balance "
+        "controller)",
+    )  # fmt: skip
+
+
+def keep(draft) -> None:
+    """The MJCF as read and its files kept (kept.py); `source` and `source_differences`."""
+    original = draft.kept
+    spec = draft.spec
+    spec["source"] = kept.keep(draft, original)
+    listed = provenance.differences(spec, original, draft.report, draft.renames)
+    extra = [{"what": one_line(w), "reason": one_line(r)} for w, r in original.listed]
+    seen = {d["what"] for d in listed}
+    spec["source_differences"] = sorted(
+        listed + [d for d in extra if d["what"] not in seen], key=lambda d: d["what"]
+    )
+    draft.changed()
+
+
+EDITS = (carry_excludes,)
+AFTER = (refuse_falling,)
