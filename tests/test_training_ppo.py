@@ -8,9 +8,9 @@ random policy's by at least `MARGIN` (measured: see docs/training.md).
 from __future__ import annotations
 
 import pytest
+from tests.test_training import _require, load_file
 
 from simkit.kitio import layout
-from tests.test_training import _require, load_file
 
 pytestmark = pytest.mark.slow
 STEPS = 60_000
@@ -34,16 +34,31 @@ def random_reward(env, episodes: int = 64, seed: int = 1) -> float:
             state = jax.vmap(env.step)(state, action)
             return (state, total + state.reward), None
 
-        (_, total), _ = jax.lax.scan(one, (state, jp.zeros(episodes)), jax.random.split(rng, EPISODE))
+        (_, total), _ = jax.lax.scan(
+            one, (state, jp.zeros(episodes)), jax.random.split(rng, EPISODE)
+        )
         return total.mean()
 
     return float(run(jax.random.PRNGKey(seed)))
 
 
+def replicate(tree, devices):
+    """`jax.device_put_replicated` (removed in JAX 0.10), which brax 0.14.2, the newest, still
+    calls once to copy the training state to each device."""
+    import jax
+    import jax.numpy as jp
+
+    return jax.pmap(lambda _: tree, devices=devices)(jp.arange(len(devices)))
+
+
 def train(env):
     """(mean episode reward of the trained policy at the last evaluation, metrics)."""
+    import jax
     from brax.training.agents.ppo import train as ppo
     from mujoco_playground import wrapper
+
+    if "device_put_replicated" not in vars(jax):
+        jax.device_put_replicated = replicate  # brax 0.14.2 on JAX 0.10
 
     _, _, metrics = ppo.train(
         environment=env,

@@ -53,6 +53,14 @@ def read_config(text: str) -> dict:
         raise ValueError("no ArticulationCfg(...) call")
     top = _keywords(cfg)
     path = _call(top["spawn"], "join")
+    files = next(
+        (
+            ast.literal_eval(node.value)
+            for node in tree.body
+            if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", None) == "USD_FILES"
+        ),
+        (),
+    )
     init = _keywords(_call(top["init_state"], "InitialStateCfg"))  # type: ignore[arg-type]
     groups = {}
     assert isinstance(top["actuators"], ast.Dict)
@@ -60,7 +68,8 @@ def read_config(text: str) -> dict:
         kw = _keywords(value)  # type: ignore[arg-type]
         groups[ast.literal_eval(key)] = {k: ast.literal_eval(v) for k, v in kw.items()}  # type: ignore[arg-type]
     return {
-        "usd": ast.literal_eval(path.args[-1]) if path is not None else None,
+        # usd_path=os.path.join(KIT_DIR, USD), USD the first of USD_FILES the kit holds
+        "usd": files if path is not None and getattr(path.args[-1], "id", "") == "USD" else (),
         "pos": ast.literal_eval(init["pos"]),
         "rot": ast.literal_eval(init["rot"]),
         "joint_pos": ast.literal_eval(init["joint_pos"]),
@@ -191,9 +200,9 @@ def check_isaaclab(kit: Kit) -> list[Finding]:
         config = read_config(kit.path(layout.ISAACLAB_CFG).read_text(encoding="utf-8"))
     except (SyntaxError, ValueError, KeyError, AssertionError, TypeError) as exc:
         return [require("training.isaaclab.read", False, f"isaaclab_cfg.py: {exc}")]
-    usd = config["usd"]
-    if not isinstance(usd, str) or not kit.path(usd).is_file():
-        return [require("training.isaaclab.usd", False, f"usd_path {usd!r} is not in the kit")]
+    usd = next((f for f in config["usd"] if kit.path(f).is_file()), None)
+    if usd is None:
+        return [require("training.isaaclab.usd", False, f"no USD_FILES {config['usd']} in the kit")]
     stage = Usd.Stage.Open(str(kit.path(usd)), Usd.Stage.LoadAll)
     joints = _stage_joints(stage)
     return [

@@ -15,7 +15,6 @@ from __future__ import annotations
 import json
 import math
 
-from simkit.emit.docs import environment
 from simkit.emit.mjcf_scene import key_qpos
 from simkit.emit.training_sensors import ROLES, base_sensors
 from simkit.kitio import layout
@@ -94,7 +93,8 @@ def values(robot: Robot) -> dict:
     return {
         "kit": py(robot.name),
         "scene": py(layout.mjcf_mjx(robot.name)),
-        "usd": py(layout.usd_asset(robot.name)),
+        # the Isaac asset's interface layer, text or binary (`--usd-format`)
+        "usd": py((layout.usd_asset(robot.name), layout.usd_asset(robot.name, True))),
         "floating": py(robot.floating_base),
         "timestep": py(timestep),
         "actuators": "{\n"
@@ -152,10 +152,27 @@ def reason_none(robot: Robot) -> str | None:
     return None
 
 
+def readme(robot: Robot) -> dict:
+    """Values for the kit README's training section (None: no training/)."""
+    if reason_none(robot) is not None:
+        return {"training": None}
+    task = (
+        "The Playground task (a starting point): stand and hold a commanded base velocity of zero."
+        if robot.floating_base
+        else "The Playground task (a starting point): reach a joint-space target sampled "
+        "within the joint limits."
+    )
+    return {
+        "training": {"home": home_pose(robot)[0], "task": task, "usd": layout.usd_asset(robot.name)}
+    }
+
+
 def emit(robot: Robot) -> dict[str, bytes]:
     """`training/playground_env.py`, `training/mjlab_cfg.py`, `training/isaaclab_cfg.py`."""
     if reason_none(robot) is not None:
         return {}
+    from simkit.emit.docs import environment  # docs imports this module for its README
+
     env, ctx = environment(), values(robot)
     ctx["spec"] = robot.spec_file
     files = {
