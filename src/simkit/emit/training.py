@@ -157,10 +157,10 @@ def readme(robot: Robot) -> dict:
     if reason_none(robot) is not None:
         return {"training": None}
     task = (
-        "The Playground task (a starting point): stand and hold a commanded base velocity of zero."
+        "The Playground task, a starting point: stand and hold a commanded base velocity of zero."
         if robot.floating_base
-        else "The Playground task (a starting point): reach a joint-space target sampled "
-        "within the joint limits."
+        else "The Playground task, a starting point: reach a joint-space target sampled within "
+        "the joint limits."
     )
     return {
         "training": {"home": home_pose(robot)[0], "task": task, "usd": layout.usd_asset(robot.name)}
