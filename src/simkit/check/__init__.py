@@ -41,6 +41,7 @@ _REGISTRY: dict[str, str] = {
     "references": "references:check_references",
     "sdf": "sdf:check_sdf",
     "source": "source:check_source",
+    "training": "training:check_training",
 }
 
 

@@ -24,6 +24,7 @@ from simkit.emit import (
     sdf,
     srdf,
     step,
+    training,
     urdf,
     usd,
 )
@@ -48,6 +49,7 @@ EMITTERS: dict[str, Emitter] = {
     "ros2_control": ros2_control.emit,
     "step": step.emit,
     "sdf": sdf.emit,
+    "training": training.emit,
 }
 
 

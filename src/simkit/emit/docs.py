@@ -10,7 +10,7 @@ import numpy as np
 
 from simkit.derive.ros2_control import controllers
 from simkit.derive.solids import CIRCULAR_SEGMENTS
-from simkit.emit import mjcf_world, robot_json
+from simkit.emit import mjcf_world, robot_json, training
 from simkit.emit.step import step_origin
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
@@ -86,6 +86,7 @@ def context(robot: Robot) -> dict:
         "segments": CIRCULAR_SEGMENTS,
         **_floating(robot),
         **_gpu(robot),
+        **training.readme(robot),
         **_fk_snippet(robot),
         **_page_extras(robot),
     }

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from simkit.emit import mjcf, mjcf_scene, mjcf_world
+from simkit.emit import mjcf, mjcf_scene, mjcf_world, training_sensors
 from simkit.kitio import layout
 from simkit.kitio.fmt import num, vec
 from simkit.kitio.xmlwriter import sub, to_bytes
@@ -160,6 +160,7 @@ def emit(robot: Robot) -> dict[str, bytes]:
     _contact(robot, mujoco, worldbody)
     mjcf.equality(robot, mujoco)
     mjcf_world.sensors(robot, mujoco)
+    training_sensors.add(robot, mujoco, worldbody)  # a floating base's IMU (issue 41)
     mjcf.actuators(robot, mujoco)
     mjcf_scene.keyframes(robot, mujoco)
     main = layout.mjcf(robot.name)

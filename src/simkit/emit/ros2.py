@@ -35,6 +35,7 @@ INSTALL_DIRS = (
     "examples",
     "docs",
     "validation",
+    "training",  # emit/training.py (issue 41)
 )
 INSTALL_FILES = ("robot.json", "ik_cases.json", "README.md", "LICENSE.txt")
 #: What display.launch.py runs and imports.

@@ -101,6 +101,14 @@ def example(name: str) -> str:
     return f"examples/{name}"
 
 
+#: The training files (emit/training.py, issue 41): a MuJoCo Playground environment, an mjlab
+#: entity config and an Isaac Lab articulation config, beside each other in `training/`.
+TRAINING_DIR = "training"
+PLAYGROUND_ENV = f"{TRAINING_DIR}/playground_env.py"
+MJLAB_CFG = f"{TRAINING_DIR}/mjlab_cfg.py"
+ISAACLAB_CFG = f"{TRAINING_DIR}/isaaclab_cfg.py"
+
+
 def asset_dir(robot: str, declared: str | None = None) -> str:
     """Folder of a kit's files under the download site's /assets/sim/ (the kit page's
     `<model>`, e.g. `1000`), the spec's `asset_dir` or else the robot name."""
