@@ -199,6 +199,8 @@ def _piece(piece: Mesh, volume: float, check: bool, kept: int | None):
     for k, candidate in enumerate(_candidates(piece, volume), 1):
         if kept is not None and k != kept:
             continue
+        if not len(candidate.faces):  # a coarser copy of a thin part can collapse to nothing
+            continue
         solid, whole = faceted(candidate)
         if kept is not None or (whole and _sound(solid, target)):
             return solid, k
