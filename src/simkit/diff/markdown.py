@@ -148,7 +148,7 @@ def cells(change: Change) -> list[str]:
 
 def summary(report: Report) -> str:
     more = len(report.round_off)
-    round_off = f" ({more} more differ only by round-off)" if more else ""
+    round_off = f" ({more} more differ only by round-off, comments or provenance)" if more else ""
     return (
         f"{len(report.changes)} change(s) beyond the checks' tolerances; files: "
         f"{len(report.added)} added, {len(report.removed)} removed, "
@@ -161,7 +161,7 @@ def no_change(report: Report) -> str:
         return "No changes: every file is byte-identical."
     return (
         f"No changes beyond the checks' tolerances ({len(report.round_off)} file(s) differ "
-        "only by round-off or provenance)."
+        "only by round-off, comments or provenance)."
     )
 
 
@@ -187,7 +187,7 @@ def to_markdown(report: Report) -> str:
         ("added", report.added),
         ("removed", report.removed),
         ("changed", report.changed),
-        ("round-off only", report.round_off),
+        ("round-off, comments or provenance only", report.round_off),
     ):
         if paths:
             lines.append(f"- {label}: " + ", ".join(f"`{p}`" for p in paths))

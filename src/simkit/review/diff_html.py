@@ -164,7 +164,7 @@ def to_html(report: Report, rows: Sequence[Row]) -> str:
             ("added", report.added),
             ("removed", report.removed),
             ("changed", report.changed),
-            ("round-off only", report.round_off),
+            ("round-off, comments or provenance only", report.round_off),
             ("provenance", report.metadata),
         )
         if paths
