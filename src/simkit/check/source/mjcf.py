@@ -2,7 +2,8 @@
 the kit's MJCF, and this compares, under the source's names (robot.json renames applied):
 
 - joint names, types (hinge, slide; a ball as three hinges about x, y, z), axes, ranges;
-- every body's mass, CoM and inertia (<= 1e-6 relative);
+- every body's mass, CoM (<= 1e-6 relative) and inertia tensor in the link frame
+  (shared.inertia_close);
 - the pose of every body at 100 seeded configurations (<= 1e-6 m, 1e-6 in rotation),
   relative to the robot's root;
 - each joint's actuator force bound (|gear| x force range, else control range x gain);
@@ -30,7 +31,7 @@ import numpy as np
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
-from simkit.check.source.shared import Allowed
+from simkit.check.source.shared import Allowed, inertia_close
 from simkit.kitio.oneline import one_line
 
 REL = 1e-6
@@ -249,7 +250,7 @@ def _bodies(p: Pairs) -> list[str]:
             f"{key}.com"
         ):
             out.append(f"link '{name}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
-        if np.max(np.abs(i0 - i1)) > REL * np.max(np.abs(i0)) and not p.listed(f"{key}.inertia"):
+        if not inertia_close(i0, i1) and not p.listed(f"{key}.inertia"):
             out.append(
                 f"link '{name}': inertia {_v(np.diag(i0))} kg m^2 in the source, "
                 f"{_v(np.diag(i1))} in the kit"
