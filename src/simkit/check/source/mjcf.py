@@ -8,7 +8,9 @@ the kit's MJCF, and this compares, under the source's names (robot.json renames 
   relative to the robot's root;
 - each joint's actuator force bound (|gear| x force range, else control range x gain);
 - contact excludes: each source `<exclude>` between two kit bodies is one in the kit's MJCF,
-  and each pair robot.json declares (`collision_pairs.declared`) is one in the source.
+  and each pair robot.json declares (`collision_pairs.declared`) is one in the source
+  (or listed: `contact_excludes.A.B`, a pair the import excluded because it overlaps at
+  the source's home, importer/fixups/overlap.py).
 
 A difference passes only when robot.json's `source_differences` lists it (key as for a URDF:
 `joints.J.axis`, `links.B.mass`, ...). The source's other files (includes, meshes) are read
@@ -395,7 +397,7 @@ def _excludes(p: Pairs, declared: list) -> list[str]:
         if pair not in kit_pairs and not p.listed(f"contact_excludes.{_name(s, 'exclude', e)}"):
             out.append(f"bodies '{a}' and '{b}': excluded from contact in the source, not the kit")
     for a, b in declared:
-        if frozenset((a, b)) not in source_pairs:
+        if frozenset((a, b)) not in source_pairs and not p.listed(f"contact_excludes.{a}.{b}"):
             out.append(f"links '{a}' and '{b}': declared excluded, not excluded in the source")
     return out
 
