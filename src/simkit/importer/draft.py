@@ -67,6 +67,9 @@ class Draft:
     renames: dict = field(default_factory=dict)
     #: mesh files translate wrote into `stage`
     meshes: int = 0
+    #: (what, reason) of differences the fix-ups make, added to `source_differences` by
+    #: the format's keep (fixups/overlap.py: pairs excluded at the source's home)
+    listed: list = field(default_factory=list)
     #: the source's first element of each (tag, name), built on first use by `where`
     _named: dict | None = field(default=None, repr=False)
 

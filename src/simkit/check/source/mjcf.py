@@ -2,12 +2,15 @@
 the kit's MJCF, and this compares, under the source's names (robot.json renames applied):
 
 - joint names, types (hinge, slide; a ball as three hinges about x, y, z), axes, ranges;
-- every body's mass, CoM and inertia (<= 1e-6 relative);
+- every body's mass, CoM (<= 1e-6 relative) and inertia tensor in the link frame
+  (shared.inertia_close);
 - the pose of every body at 100 seeded configurations (<= 1e-6 m, 1e-6 in rotation),
   relative to the robot's root;
 - each joint's actuator force bound (|gear| x force range, else control range x gain);
 - contact excludes: each source `<exclude>` between two kit bodies is one in the kit's MJCF,
-  and each pair robot.json declares (`collision_pairs.declared`) is one in the source.
+  and each pair robot.json declares (`collision_pairs.declared`) is one in the source
+  (or listed: `contact_excludes.A.B`, a pair the import excluded because it overlaps at
+  the source's home, importer/fixups/overlap.py).
 
 A difference passes only when robot.json's `source_differences` lists it (key as for a URDF:
 `joints.J.axis`, `links.B.mass`, ...). The source's other files (includes, meshes) are read
@@ -30,7 +33,7 @@ import numpy as np
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
-from simkit.check.source.shared import Allowed
+from simkit.check.source.shared import Allowed, inertia_close
 from simkit.kitio.oneline import one_line
 
 REL = 1e-6
@@ -249,7 +252,7 @@ def _bodies(p: Pairs) -> list[str]:
             f"{key}.com"
         ):
             out.append(f"link '{name}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
-        if np.max(np.abs(i0 - i1)) > REL * np.max(np.abs(i0)) and not p.listed(f"{key}.inertia"):
+        if not inertia_close(i0, i1) and not p.listed(f"{key}.inertia"):
             out.append(
                 f"link '{name}': inertia {_v(np.diag(i0))} kg m^2 in the source, "
                 f"{_v(np.diag(i1))} in the kit"
@@ -394,7 +397,7 @@ def _excludes(p: Pairs, declared: list) -> list[str]:
         if pair not in kit_pairs and not p.listed(f"contact_excludes.{_name(s, 'exclude', e)}"):
             out.append(f"bodies '{a}' and '{b}': excluded from contact in the source, not the kit")
     for a, b in declared:
-        if frozenset((a, b)) not in source_pairs:
+        if frozenset((a, b)) not in source_pairs and not p.listed(f"contact_excludes.{a}.{b}"):
             out.append(f"links '{a}' and '{b}': declared excluded, not excluded in the source")
     return out
 

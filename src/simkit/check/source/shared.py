@@ -8,16 +8,34 @@ import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.errors import SimkitError
+from simkit.kitio.fmt import ZERO_BELOW
 from simkit.kitio.oneline import one_line
 
 #: relative tolerance: the kit carries 10 significant digits (kitio/fmt.py); a hand-typed
 #: source rarely more. Far below any real change (an axis turned, a mass 10 % off).
 REL = 1e-6
-#: m: absolute floor for lengths; kg m^2 floor for inertia terms is REL x the largest moment
+#: m: absolute floor for lengths
 ABS_LENGTH = 1e-9
+#: kg m^2: an inertia tensor's tolerance is REL x its Frobenius norm (a norm, not the
+#: principal moments or axes: two nearly equal moments leave the axes ill-defined, the tensor
+#: not) plus the writer's zero floor: kitio/fmt writes any term below ZERO_BELOW (1e-12) as
+#: 0, so a product of inertia that small is not carried (fingertips of 1e-7 kg m^2 whose
+#: frame is turned a little from their principal axes).
+INERTIA_FLOOR = ZERO_BELOW
+
+
+def inertia_close(a, b) -> bool:
+    """Two inertia tensors (3x3, kg m^2, the same link axes) agree: every term within
+    REL x the source tensor's Frobenius norm + INERTIA_FLOOR."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return bool(np.max(np.abs(a - b)) <= REL * float(np.linalg.norm(a)) + INERTIA_FLOOR)
+
+
 #: failures named per finding category before "and N more"
 SHOWN = 20
 

@@ -20,7 +20,7 @@ import numpy as np
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
-from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed
+from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
 from simkit.kitio.oneline import one_line
 
 #: attributes holding numbers that the comparison reads (origins, axes, limits, inertials)
@@ -228,8 +228,7 @@ def _mass(src, kit, allowed: Allowed) -> list[str]:
         c0, c1, float(np.max(np.abs(c0))), ABS_LENGTH
     ):
         out.append(f"link '{shown}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
-    scale = float(np.max(np.abs(i0)))
-    if f"{key}.inertia" not in allowed.keys and not _close(i0, i1, scale, 0.0):
+    if f"{key}.inertia" not in allowed.keys and not inertia_close(i0, i1):
         out.append(
             f"link '{shown}': inertia (link axes) {_v(np.diag(i0))} kg m^2 on the diagonal "
             f"in the source, {_v(np.diag(i1))} in the kit"

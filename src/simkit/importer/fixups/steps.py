@@ -9,7 +9,8 @@ place to stand), and gives each change one report line with its reason:
 1. `base`: a floating robot drawn Y-up is turned to stand on its limbs (upright.py).
 2. `home`: out of self-contact: any joint between touching links may move for a fixed base
    (home.py), then to where the servos hold it against gravity (gravity.py); a floating
-   robot keeps its feet and comes to rest on the floor (stance.py).
+   robot keeps its feet and comes to rest on the floor (stance.py); pairs the search leaves
+   touching that already touch at the source's home are excluded (overlap.py).
 3. `stand`: the floating base placed on the floor (standing.py), or where it comes to rest
    leaning on its frame (settle.py); a legged robot bolted at its root is raised so that its
    feet reach the floor.
@@ -20,7 +21,7 @@ place to stand), and gives each change one report line with its reason:
 from __future__ import annotations
 
 from simkit.importer.draft import Draft
-from simkit.importer.fixups import gravity, settle, stance, standing, upright
+from simkit.importer.fixups import gravity, overlap, settle, stance, standing, upright
 from simkit.importer.fixups import home as clear
 from simkit.importer.fixups import limits as ranges
 from simkit.importer.fixups.rotors import armature
@@ -59,6 +60,14 @@ def home(draft: Draft) -> None:
     """`home` out of self-contact; for a fixed base, also held against gravity."""
     if not searched(draft, "home out of self-contact and held against gravity"):
         return
+    first = list((draft.spec.get("poses") or {}).get("home", []))
+    _search_home(draft)
+    if first:
+        overlap.exclude(draft, first)
+
+
+def _search_home(draft: Draft) -> None:
+    """home.py's or stance.py's search, then the servos that hold it."""
     if draft.floating:  # stance.py: out of self-contact with the feet kept
         why = (
             "at the first guess (0, or mid-range outside the limits) links collide or the "

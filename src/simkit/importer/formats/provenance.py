@@ -58,6 +58,13 @@ def as_read(source: Source) -> Source:
     return replace(source, root=copy.deepcopy(source.root))
 
 
+def merged(listed: list[dict], extra: list[tuple[str, str]]) -> list[dict]:
+    """`listed` with each (what, reason) of `extra` whose `what` it lacks, sorted by `what`."""
+    seen = {d["what"] for d in listed}
+    more = [{"what": one_line(w), "reason": one_line(r)} for w, r in extra]
+    return sorted(listed + [d for d in more if d["what"] not in seen], key=lambda d: d["what"])
+
+
 def differences(
     spec: dict, source: Source, report: Report, renames: dict[str, dict[str, str]]
 ) -> list[dict]:

@@ -106,6 +106,8 @@ def shape_of(source: Source, element, writer: MeshWriter, report: Report, what: 
         return {"shape": kind, "radius": radius, "length": length, **pose}, None
     if kind == "sphere":
         radius = floats(source, shape, "radius", 1)
+        if radius == 0 and what == "collision":  # a contact point: translate/points.py
+            return {"shape": "sphere", "radius": 0.0, **pose}, None
         if radius <= 0:
             report.dropped(source, shape, f"{what} sphere with radius <= 0")
             return None

@@ -8,7 +8,7 @@ import numpy as np
 
 from simkit.importer.diagnostics import Report
 from simkit.importer.read.source import Source
-from simkit.importer.translate import inertia_limit
+from simkit.importer.translate import inertia_limit, points
 from simkit.importer.translate.geometry import floats, origin, shape_of
 from simkit.importer.translate.masses import solid_mass
 from simkit.importer.translate.meshes import MeshWriter
@@ -172,6 +172,8 @@ def link_spec(
         if got is not None:
             collisions.append(got[0])
             infos.append(got[1])
+    if points.grown(source, link, collisions, report):
+        spec["estimated"] = [*spec.get("estimated", []), "collision_primitives"]
     solid = visuals
     weighed = "mass" not in spec and (bool(visuals) or volume_mass)
     if not visuals and collisions:

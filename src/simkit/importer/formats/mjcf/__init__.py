@@ -26,7 +26,6 @@ from simkit.importer.formats.mjcf import excludes, kept, reader, tree
 from simkit.importer.formats.mjcf.reader import MjcfSource
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
-from simkit.kitio.oneline import one_line
 
 #: the kit's own words for the source, in report lines and the spec's header
 NOUN = "MJCF"
@@ -101,11 +100,7 @@ def keep(draft) -> None:
     spec = draft.spec
     spec["source"] = kept.keep(draft, original)
     listed = provenance.differences(spec, original, draft.report, draft.renames)
-    extra = [{"what": one_line(w), "reason": one_line(r)} for w, r in original.listed]
-    seen = {d["what"] for d in listed}
-    spec["source_differences"] = sorted(
-        listed + [d for d in extra if d["what"] not in seen], key=lambda d: d["what"]
-    )
+    spec["source_differences"] = provenance.merged(listed, [*original.listed, *draft.listed])
     draft.changed()
 
 

@@ -57,7 +57,8 @@ def keep(draft) -> None:
     name = f"{spec['name']}.source.urdf"
     (draft.stage / name).write_bytes(data)
     spec["source"] = provenance.entry(draft, name, data)
-    spec["source_differences"] = provenance.differences(spec, original, draft.report, draft.renames)
+    listed = provenance.differences(spec, original, draft.report, draft.renames)
+    spec["source_differences"] = provenance.merged(listed, draft.listed)
     draft.changed()
 
 
