@@ -49,22 +49,3 @@ def test_malformed_xml_and_an_uncompilable_model_are_one_line(tmp_path):
     assert "malformed XML" in _refused(write(tmp_path, "<mujoco><worldbody>"), tmp_path / "o")
     bad = arm('<joint name="j1" type="nonsense"/>')
     assert "MuJoCo cannot compile" in _refused(write(tmp_path, bad), tmp_path / "o")
-
-
-FALLING = """<mujoco model="m">
-  <worldbody>
-    <body name="pole" pos="0 0 1"><freejoint/>
-      <geom type="capsule" fromto="0 0 -1 0 0 0" size="0.01" mass="1"/>
-      <body name="arm"><joint name="j1" axis="0 1 0" range="-0.1 0.1"/>
-        <geom type="box" pos="0.3 0 0" size="0.3 0.02 0.02" mass="1"/></body>
-    </body>
-  </worldbody>
-</mujoco>
-"""
-
-
-def test_a_floating_robot_that_cannot_stand_is_refused(tmp_path):
-    """A pole on a round end with an arm to one side falls over: a kit could not hold it.
-    The line names the construct, at the free joint's line."""
-    line = _refused(write(tmp_path, FALLING), tmp_path / "out")
-    assert "model.xml:3: freejoint: a free base that needs active balance" in line

@@ -4,6 +4,12 @@ passive drop onto the floor, and the control scene holds the standing pose.
 Issue 6 ("Asimov legged robot"), item 5: a 1 s passive drop with no NaN; the actuated scene
 holds the standing pose for 2 s with the base height drifting less than 2 cm. As MuJoCo
 Menagerie does, any MuJoCo warning raised on the way fails the check.
+
+A robot that needs active balance (robot.json `floating_base.needs_active_balance`: an
+imported passive biped that cannot stand on position servos) keeps the drop and replaces the
+stand with a suspended hold: the base held in place just above its standing height (its
+free joint set back after every step, for the check only), the servos hold `home` within
+the fixed-base hold's tolerance, with a finite state and no MuJoCo warning.
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
+from simkit.check.mujoco import HOLD_TOLERANCE_DEG
 from simkit.model.kinematics import quat_wxyz, rpy_matrix
 
 DROP_SECONDS = 1.0
@@ -124,8 +131,58 @@ def check_stand(kit: Kit) -> list[Finding]:
     ]
 
 
+def _servo_file(kit: Kit) -> tuple[str, mujoco.MjModel]:
+    """The file with the servos (the scene where the main file has none) and its model."""
+    file = kit.doc["files"].get("mjcf_scene", kit.mjcf)
+    return file, _load(kit, file)
+
+
+def check_suspended(kit: Kit) -> list[Finding]:
+    """A robot that needs active balance, its base held `DROP_HEIGHT` above its standing
+    height (feet clear of the floor): the servos hold `home` (deg) for `HOLD_SECONDS`."""
+    file, model = _servo_file(kit)
+    if model.nu == 0 and kit.joints:
+        return [require("legged.hold", False, f"{file} has no actuators to hold the pose")]
+    data = standing_state(kit, model, DROP_HEIGHT)
+    free = model.joint(kit.doc["floating_base"]["joint"]).id
+    qa, va = model.jnt_qposadr[free], model.jnt_dofadr[free]
+    held = data.qpos[qa : qa + 7].copy()
+    names = [j["name"] for j in kit.joints]
+    at = [model.jnt_qposadr[model.joint(n).id] for n in names]
+    home = np.asarray(kit.doc.get("home") or [0.0] * len(names), dtype=float)
+    finite = True
+    for _ in range(round(HOLD_SECONDS / model.opt.timestep)):
+        data.qpos[qa : qa + 7], data.qvel[va : va + 6] = held, 0.0  # the hold, check only
+        mujoco.mj_step(model, data)
+        if not (np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))):
+            finite = False
+            break
+    error = np.degrees(np.abs(data.qpos[at] - home)) if finite else np.full(len(names), np.inf)
+    span = f"{HOLD_SECONDS:g} s suspended in {file} (base held {DROP_HEIGHT:g} m up)"
+    return [
+        require("legged.hold.finite", finite, f"{span}: state finite"),
+        compare(
+            "legged.hold.home",
+            f"servos hold 'home', {span}",
+            np.zeros_like(error),
+            error,
+            HOLD_TOLERANCE_DEG,
+            "deg",
+            names,
+        ),
+        require(
+            "legged.hold.warnings",
+            not _warnings(data),
+            f"MuJoCo warnings while suspended: {_warnings(data) or 'none'}",
+        ),
+    ]
+
+
 def check_legged(kit: Kit) -> list[Finding]:
-    """Both checks, for kits with a floating base only."""
+    """The drop and the stand (a suspended hold where the robot needs active balance), for
+    kits with a floating base only."""
     if "floating_base" not in kit.doc:
         return []
+    if kit.doc["floating_base"].get("needs_active_balance"):
+        return check_drop(kit) + check_suspended(kit)
     return check_drop(kit) + check_stand(kit)

@@ -208,6 +208,7 @@ def _floating(robot: Robot) -> dict:
             "child": joint.child,
             "xyz": ", ".join(num(v) for v in joint.xyz),
             "quat": ", ".join(num(v) for v in quat_wxyz(rpy_matrix(joint.rpy))),
+            "balance": robot.needs_active_balance or "",
         },
         "fixed_base": "False" if joint is not None else "True",
         "scene": scene,

@@ -300,6 +300,8 @@ def _generalise(robot: Robot, doc: dict) -> None:
             "note": "MJCF free joint; the URDF's root is the child link (no world joint); "
             "MuJoCo qpos starts with its position (m) and quaternion (w, x, y, z)",
         }
+        if robot.needs_active_balance:  # the legged check holds it suspended (check/legged.py)
+            doc["floating_base"]["needs_active_balance"] = robot.needs_active_balance
         doc["frames"][robot.root]["role"] = "the world; the floating base moves freely in it"
     if robot.mjcf is not None and robot.mjcf.sensors:
         doc["sensors"] = [s.model_dump(exclude_none=True) for s in robot.mjcf.sensors]

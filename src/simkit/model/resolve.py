@@ -227,6 +227,7 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         source_about=_source_about(spec),
         source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
         contact_excludes=tuple(sorted(tuple(sorted(p)) for p in spec.contact_excludes)),
+        needs_active_balance=spec.needs_active_balance,
     )
 
 

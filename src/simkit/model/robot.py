@@ -325,6 +325,8 @@ class Robot:
     #: link pairs the source excludes from contact (spec `contact_excludes`), names sorted
     #: within each pair and the pairs sorted
     contact_excludes: tuple[tuple[str, str], ...] = ()
+    #: why the floating robot needs active balance (spec `needs_active_balance`), or None
+    needs_active_balance: str | None = None
 
     @cached_property
     def by_name(self) -> tuple[dict[str, Link], dict[str, Joint]]:

@@ -377,6 +377,10 @@ class RobotSpec(Strict):
     sources: tuple[str, ...] = ()
     root: str = "base_footprint"
     floating_base: bool = False
+    #: why a floating robot cannot stand on the kit's position servos (one line, an
+    #: import's settle: `sinks 0.51 m in 2 s`): robot.json and the README say it needs
+    #: active balance, and the legged check holds its base suspended instead of standing
+    needs_active_balance: Annotated[str, Field(min_length=1, pattern=r"^[^\n]+$")] | None = None
     wrist_centre: str | None = None
     tool_frame: str | None = None
     materials: tuple[MaterialSpec, ...] = ()

@@ -107,7 +107,21 @@ def differences(
                 kind_in = f"a {element.get('type')} joint in the {source.noun}"
                 add(f"joints.{old}.type", said or kind_in)
     _massless(source, add)
+    _loops(source, records, add)
     return [out[k] for k in sorted(out)]
+
+
+def _loops(source: Source, report: Said, add) -> None:
+    """A joint whose child link already hangs from an earlier joint (a closed loop) is left
+    out of the kit (formats/urdf/repairs.py): listed as `joints.J` with its report line."""
+    parented: set[str] = set()
+    for joint in source.root.findall("joint"):
+        child = joint.find("child")
+        link = None if child is None else child.get("link")
+        if link in parented:
+            said = _said(report, source, joint) or "a second parent joint: a closed loop"
+            add(f"joints.{joint.get('name')}", said)
+        parented.add(link)
 
 
 def _massless(source: Source, add) -> None:

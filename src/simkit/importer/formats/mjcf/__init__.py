@@ -7,7 +7,8 @@
 - `keep`: the model file byte for byte and every file it read (kept.py), and the
   differences: the shared ones (formats/provenance.py) and the listed ones;
 - `EDITS`: the model's contact excludes carried into the spec (excludes.py);
-- `AFTER`: a free base that falls on the kit's servos is refused (fixups/falling.py).
+- `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
+  (fixups/falling.py; the kit says so, its legged check holds the base suspended).
 """
 
 from __future__ import annotations
@@ -19,11 +20,11 @@ import tempfile
 from dataclasses import replace
 from pathlib import Path
 
-from simkit.errors import SpecError
 from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
 from simkit.importer.formats.mjcf import excludes, kept, reader, tree
 from simkit.importer.formats.mjcf.reader import MjcfSource
+from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -71,27 +72,36 @@ def carry_excludes(draft) -> None:
     draft.kept.listed = [*draft.kept.listed, *listed]
 
 
-def refuse_falling(draft) -> None:
-    """One line when a floating MJCF robot does not stand on the kit's servos
-    (fixups/falling.py): the line names the construct, a free base that needs active
-    balance (and, where the MJCF drives its joints by torque `<motor>`s, says so), at the
-    free joint's line."""
+def mark_falling(draft) -> None:
+    """A floating MJCF robot that does not stand on the kit's servos (fixups/falling.py: a
+    passive biped, an RL humanoid on round feet) is built, not refused: the spec's
+    `needs_active_balance` gives the settle's figures (and, where the MJCF drives its joints
+    by torque `<motor>`s, says so), robot.json and the README say the robot needs active
+    balance, and the legged check holds its base suspended instead of standing. One report
+    line, at the free joint's line."""
     drop = falling.sinks(draft)
     if drop is None:
         return
-    source = draft.kept
-    model = source.model
-    free = [j for j in range(model.njnt) if model.jnt_type[j] == 0]
+    model = draft.kept.model
     motors = any(
         model.actuator_gaintype[a] == 0 and model.actuator_biastype[a] == 0 for a in range(model.nu)
     )
-    why = "torque <motor>s drive its joints; " if motors else ""
-    raise SpecError(
-        str(source.path), source.lines.get(("jnt", free[0])) if free else None, "freejoint",
-        f"a free base that needs active balance: on a kit's position servos at home it "
-        f"sinks {drop:.2f} m in {settle.SECONDS:g} s ({why}a kit carries no balance "
-        "controller)",
-    )  # fmt: skip
+    why = "; torque <motor>s drive its joints in the MJCF" if motors else ""
+    reason = (
+        f"on the kit's position servos at home its base sinks {drop:.2f} m in "
+        f"{settle.SECONDS:g} s{why}"
+    )
+    draft.spec["needs_active_balance"] = reason
+    draft.changed()
+    free = [j for j in range(model.njnt) if model.jnt_type[j] == 0]
+    line = draft.kept.lines.get(("jnt", free[0])) if free else None
+    draft.report.changed(
+        draft.kept,
+        Position("freejoint", line),
+        f"a free base that needs active balance ({reason}; a kit carries no balance "
+        "controller): built, said in robot.json and the README; the legged check holds the "
+        "base suspended instead of standing",
+    )
 
 
 def keep(draft) -> None:
@@ -105,4 +115,4 @@ def keep(draft) -> None:
 
 
 EDITS = (carry_excludes,)
-AFTER = (refuse_falling,)
+AFTER = (mark_falling,)

@@ -41,10 +41,12 @@ def read(shell: Source, options: ReadOptions) -> Source:
 
 def repaired(source: Source) -> Source:
     """`source` (a parsed URDF) kept as read (`kept`), then its repairs applied in place:
-    an include expanded twice, an undeclared frame the robot is mounted on."""
+    an include expanded twice, an undeclared frame the robot is mounted on, a second parent
+    joint (a closed loop)."""
     source.kept = provenance.as_read(source)
     repairs.identical_duplicates(source, source.report)
     repairs.mounting_frame(source, source.report)
+    repairs.second_parents(source, source.report)
     return source
 
 

@@ -1,0 +1,56 @@
+"""A link with two parent joints (issue 42, class 8): an end effector fixed both to the arm's
+last link and to the base is a closed loop. The tree is built from the link's first joint in
+document order, the later joint is left out with one report line and listed in
+`source_differences`, and the kit built from it passes its checks (the source check
+included: the kept URDF still holds both joints)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+
+from simkit.importer import import_robot
+from urdf_parts import joint, link, write
+
+
+def _looped(tmp_path, frame: str = "base"):
+    """base -> upper (revolute) -> tip (fixed), and tip fixed to `frame` too (the loop):
+    the base, or an undeclared world the base is bolted to (the mounting frame)."""
+    mount = [joint("mount", "world", "base", "fixed")] if frame == "world" else []
+    return write(
+        tmp_path,
+        "looped",
+        *mount,
+        link("base"),
+        link("upper"),
+        link("tip", mass="0.2"),
+        joint("shoulder", "base", "upper"),
+        joint("tip_mount", "upper", "tip", "fixed"),
+        joint("tip_to_base", frame, "tip", "fixed"),
+    )
+
+
+def test_the_first_joint_builds_the_tree_and_the_second_is_listed(tmp_path):
+    done = import_robot(_looped(tmp_path), tmp_path / "out")
+    spec = yaml.safe_load(done.spec_path.read_text())
+    joints = {j["name"]: j for j in spec["joints"]}
+    assert "tip_to_base" not in joints
+    assert (joints["tip_mount"]["parent"], joints["tip_mount"]["child"]) == ("upper", "tip")
+    said = [line for line in done.lines if "closed loop" in line]
+    assert len(said) == 1 and "joint[tip_to_base]" in said[0] and "'tip_mount'" in said[0]
+    listed = {d["what"]: d["reason"] for d in spec["source_differences"]}
+    assert "closed loop" in listed["joints.tip_to_base"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("frame", ["base", "world"])
+def test_the_looped_robot_builds_a_checked_kit(tmp_path, frame):
+    from simkit.pipeline import build
+
+    done = import_robot(_looped(tmp_path, frame), tmp_path / "out")
+    result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
+    assert any(f.check == "source.joints" and f.ok for f in result.findings)
+    robot = json.loads((result.kit_dir / "robot.json").read_text())
+    assert any(d["what"] == "joints.tip_to_base" for d in robot["source_differences"])
