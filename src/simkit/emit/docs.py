@@ -3,37 +3,18 @@
 from __future__ import annotations
 
 import math
-from functools import cache
 
-import jinja2
 import numpy as np
 
 from simkit.derive.ros2_control import controllers
 from simkit.derive.solids import CIRCULAR_SEGMENTS
 from simkit.emit import mjcf_world, robot_json, training
 from simkit.emit.step import step_origin
+from simkit.emit.templating import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
-from simkit.kitio.resources import data_dir
 from simkit.model.kinematics import chain, quat_wxyz, rpy_matrix
 from simkit.model.robot import Robot
-
-
-@cache
-def environment() -> jinja2.Environment:
-    """The template environment shared by every text emitter."""
-    from simkit.emit.escape import FILTERS
-
-    env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(data_dir("templates"))),
-        undefined=jinja2.StrictUndefined,
-        keep_trailing_newline=True,
-        trim_blocks=True,
-        lstrip_blocks=True,
-        autoescape=False,
-    )
-    env.filters.update(FILTERS)  # every value goes through its language's filter (escape.py)
-    return env
 
 
 def _deg(value: float | None) -> str:

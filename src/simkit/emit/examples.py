@@ -8,7 +8,7 @@ examples/fk_ik.py comes from the motion-data emitter.
 from __future__ import annotations
 
 from simkit.emit import mjcf_world
-from simkit.emit.docs import environment
+from simkit.emit.templating import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.model.robot import Robot

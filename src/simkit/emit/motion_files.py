@@ -8,7 +8,7 @@ cases".
 
 from __future__ import annotations
 
-from simkit.emit.docs import environment
+from simkit.emit.templating import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.kitio.jsonout import dumps

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from simkit import __version__
-from simkit.emit.docs import environment
+from simkit.emit.templating import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.model.kinematics import forward

@@ -20,7 +20,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from simkit.derive.ros2_control import controller_base, controllers, joints
-from simkit.emit.docs import environment
+from simkit.emit.templating import environment
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.kitio.xmlwriter import sub

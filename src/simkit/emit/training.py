@@ -16,7 +16,9 @@ import json
 import math
 
 from simkit.emit.mjcf_scene import key_qpos
+from simkit.emit.templating import environment
 from simkit.emit.training_sensors import ROLES, base_sensors
+from simkit.emit.usd.mimic import driven_follower
 from simkit.kitio import layout
 from simkit.kitio.fmt import num
 from simkit.model.robot import Robot
@@ -70,6 +72,24 @@ def actuators(robot: Robot) -> dict[str, dict]:
     return out
 
 
+def isaac_actuators(robot: Robot) -> dict[str, dict]:
+    """The servos the USD drives (`actuators`), plus each prismatic mimic follower the USD
+    drives with its leader's servo (emit/usd/mimic.py `driven_follower`: PhysX does not
+    couple a linear mimic), with the follower's own range, velocity and armature."""
+    out = actuators(robot)
+    for joint in robot.movable_joints:
+        if joint.name in out or not driven_follower(robot, joint):
+            continue
+        lead = out[joint.mimic[0]]
+        out[joint.name] = {
+            **lead,
+            "range": (joint.lower, joint.upper) if joint.lower is not None else None,
+            "velocity": joint.max_velocity or None,
+            "armature": joint.armature,
+        }
+    return out
+
+
 def feet(robot: Robot) -> tuple[str, ...]:
     """A floating robot's floor-pair colliders within 1 cm of the floor at home (the GPU
     scene's plan; derive/gpu_scene.py's own rule)."""
@@ -111,7 +131,7 @@ def values(robot: Robot) -> dict:
             tuple(s.name for s in robot.mjcf.sensors) if robot.mjcf is not None else ()
         ),
         "feet": py(feet(robot)),
-        "groups": _groups(acts),
+        "groups": _groups(isaac_actuators(robot)),
     }
 
 
@@ -143,7 +163,8 @@ def _groups(acts: dict[str, dict]) -> list[dict]:
 
 def reason_none(robot: Robot) -> str | None:
     """Why a kit gets no `training/` (one line), or None when it gets one."""
-    if robot.products.gpu_scene is None:
+    plan = robot.products.gpu_scene
+    if plan is None or "none" in plan:  # none: the GPU scene's own line says why
         return "no GPU scene to train on"
     if not robot.actuators:
         return "no position servos: neither a reach nor a stance task can act"
@@ -171,10 +192,8 @@ def emit(robot: Robot) -> dict[str, bytes]:
     """`training/playground_env.py`, `training/mjlab_cfg.py`, `training/isaaclab_cfg.py`."""
     if reason_none(robot) is not None:
         return {}
-    from simkit.emit.docs import environment  # docs imports this module for its README
-
     env, ctx = environment(), values(robot)
-    ctx["spec"] = robot.spec_file
+    ctx["spec"], ctx["title"] = robot.spec_file, robot.title
     files = {
         layout.PLAYGROUND_ENV: "training/playground_env.py.j2",
         layout.MJLAB_CFG: "training/mjlab_cfg.py.j2",
