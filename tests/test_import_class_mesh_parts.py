@@ -63,10 +63,12 @@ def test_a_cavity_stays_a_cavity_and_disjoint_parts_are_kept_as_read():
     assert solid.volume() == pytest.approx(1e-3 - 0.05**3 + 1e-6, rel=1e-6)
 
 
-URDF = """<robot name="parts">
+def one_mesh_urdf(name: str, mesh_file: str) -> str:
+    """A two-link URDF whose base's visual is `mesh_file` (beside it) and whose tip is a box."""
+    return f"""<robot name="{name}">
   <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
     ixy="0" ixz="0" iyz="0"/></inertial>
-    <visual><geometry><mesh filename="parts.obj"/></geometry></visual></link>
+    <visual><geometry><mesh filename="{mesh_file}"/></geometry></visual></link>
   <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
     <origin xyz="0 0 0.2"/><axis xyz="0 0 1"/>
     <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
@@ -75,6 +77,9 @@ URDF = """<robot name="parts">
     <visual><geometry><box size="0.05 0.05 0.05"/></geometry></visual></link>
 </robot>
 """
+
+
+URDF = one_mesh_urdf("parts", "parts.obj")
 
 
 @pytest.mark.slow

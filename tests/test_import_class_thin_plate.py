@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from tests.test_import_class_mesh_parts import one_mesh_urdf
 
 from simkit.derive.solids import link_solid
 from simkit.importer import import_robot
@@ -20,18 +21,7 @@ from simkit.pipeline import build
 WIDTH, DEPTH, THICK = 0.508, 0.383, 0.0066  # m
 OVERLAP = 0.01  # m: the four quarters overlap by this much at the middle
 
-URDF = """<robot name="plate">
-  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
-    ixy="0" ixz="0" iyz="0"/></inertial>
-    <visual><geometry><mesh filename="plate.stl"/></geometry></visual></link>
-  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/>
-    <origin xyz="0 0 0.2"/><axis xyz="0 0 1"/>
-    <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-  <link name="tip"><inertial><mass value="0.5"/><inertia ixx="0.001" iyy="0.001" izz="0.001"
-    ixy="0" ixz="0" iyz="0"/></inertial>
-    <visual><geometry><box size="0.05 0.05 0.05"/></geometry></visual></link>
-</robot>
-"""
+URDF = one_mesh_urdf("plate", "plate.stl")
 
 
 def _plate() -> trimesh.Trimesh:

@@ -12,7 +12,6 @@ import contextlib
 import hashlib
 import json
 import os
-import shutil
 import socket
 import subprocess
 import sys
@@ -21,17 +20,8 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from tests.test_view import CHROMIUM, FLAGS
 
-CHROMIUM = os.environ.get("SIMKIT_CHROMIUM") or shutil.which("chromium")
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
 #: rad: |WASM - Python| of every joint after 1 s (measured: docs/publish.md)
 ARM_TOLERANCE = 1e-6
 #: m: pelvis height after 2 s (the issue's bound)
