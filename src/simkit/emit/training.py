@@ -72,11 +72,12 @@ def actuators(robot: Robot) -> dict[str, dict]:
     return out
 
 
-def isaac_actuators(robot: Robot) -> dict[str, dict]:
-    """The servos the USD drives (`actuators`), plus each prismatic mimic follower the USD
-    drives with its leader's servo (emit/usd/mimic.py `driven_follower`: PhysX does not
-    couple a linear mimic), with the follower's own range, velocity and armature."""
-    out = actuators(robot)
+def isaac_actuators(robot: Robot, acts: dict[str, dict]) -> dict[str, dict]:
+    """The servos the USD drives (`acts`, from `actuators`), plus each prismatic mimic
+    follower the USD drives with its leader's servo (emit/usd/mimic.py `driven_follower`:
+    PhysX does not couple a linear mimic), with the follower's own range, velocity and
+    armature."""
+    out = dict(acts)
     for joint in robot.movable_joints:
         if joint.name in out or not driven_follower(robot, joint):
             continue
@@ -131,7 +132,7 @@ def values(robot: Robot) -> dict:
             tuple(s.name for s in robot.mjcf.sensors) if robot.mjcf is not None else ()
         ),
         "feet": py(feet(robot)),
-        "groups": _groups(isaac_actuators(robot)),
+        "groups": _groups(isaac_actuators(robot, acts)),
     }
 
 
