@@ -240,12 +240,30 @@ def _mjlab(kit: Kit, velocities: dict) -> list[Finding]:
     return found
 
 
+def expected_training(doc: dict) -> str | None:
+    """Why robot.json says this kit has no `training/` (a GPU scene file, position servos, all
+    with finite efforts), or None when it must have one. Read from robot.json alone, so a kit
+    whose training/ was deleted fails, and one that never had it passes with the reason."""
+    if not isinstance((doc.get("gpu_scene") or {}).get("file"), str):
+        return "no GPU scene to train on"
+    servos = doc.get("actuators") or []
+    if not servos:
+        return "no position servos: neither a reach nor a stance task can act"
+    if any(not math.isfinite(float(a.get("forcerange", math.inf))) for a in servos):
+        return "a servo without an effort limit"
+    return None
+
+
 def check_training(kit: Kit) -> list[Finding]:
     """The three training files against the GPU scene and the USD (none: nothing to check)."""
     files = (layout.PLAYGROUND_ENV, layout.MJLAB_CFG, layout.ISAACLAB_CFG)
     present = [f for f in files if kit.path(f).is_file()]
+    expected = expected_training(kit.doc)
     if not present:
-        return [require("training.present", True, "no training/ in this kit")]
+        why = "no training/ in this kit" + (f" ({expected})" if expected else "")
+        return [require("training.present", expected is not None, why)]
+    if expected is not None:
+        return [require("training.present", False, f"training/ in a kit without one: {expected}")]
     if len(present) != len(files):
         return [require("training.present", False, f"training/ has only {present}")]
     from simkit.check.training_usd import check_isaaclab
