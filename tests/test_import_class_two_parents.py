@@ -1,7 +1,8 @@
 """A link with two parent joints (issue 42, class 8): an end effector fixed both to the arm's
 last link and to the base is a closed loop. The tree is built from the link's first joint in
-document order, the later joint is left out with one report line and listed in
-`source_differences`, and the kit built from it passes its checks (the source check
+document order; the later joint closes the loop as a weld (spec `loops`, at the pose the
+tree gives at home), with one report line, listed in `source_differences`; the kit built
+from it carries the weld in its MJCF and USD, and passes its checks (the source check
 included: the kept URDF still holds both joints)."""
 
 from __future__ import annotations
@@ -40,8 +41,19 @@ def test_the_first_joint_builds_the_tree_and_the_second_is_listed(tmp_path):
     assert (joints["tip_mount"]["parent"], joints["tip_mount"]["child"]) == ("upper", "tip")
     said = [line for line in done.lines if "closed loop" in line]
     assert len(said) == 1 and "joint[tip_to_base]" in said[0] and "'tip_mount'" in said[0]
+    assert "weld" in said[0]
     listed = {d["what"]: d["reason"] for d in spec["source_differences"]}
     assert "closed loop" in listed["joints.tip_to_base"]
+    (loop,) = spec["loops"]
+    assert (loop["name"], loop["type"], loop["link1"], loop["link2"]) == (
+        "tip_to_base",
+        "weld",
+        "base",
+        "tip",
+    )
+    # the tree at home (shoulder at 0): tip 0.4 m above the base, turned 1 rad about z
+    assert loop["xyz"] == pytest.approx([0, 0, 0.4], abs=1e-9)
+    assert loop["rpy"] == pytest.approx([0, 0, 1.0], abs=1e-9)
 
 
 @pytest.mark.slow

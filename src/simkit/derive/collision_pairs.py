@@ -49,10 +49,13 @@ def has_geometry(link: Link) -> bool:
 
 
 def adjacent_pairs(robot: Robot) -> list[tuple[str, str]]:
-    """Pairs of links with collision geometry joined by a joint, or by a chain of links and
-    frames without geometry (MoveIt Setup Assistant's connection graph), sorted."""
+    """Pairs of links with collision geometry joined by a joint or a loop closure, or by a
+    chain of links and frames without geometry (MoveIt Setup Assistant's connection graph),
+    sorted."""
     solid = {link.name for link in robot.links if has_geometry(link)}
-    return sorted(contracted_pairs(((j.parent, j.child) for j in robot.joints), solid))
+    joined = [(j.parent, j.child) for j in robot.joints]
+    joined += [(lp.link1, lp.link2) for lp in robot.loops]  # a loop closure joins them too
+    return sorted(contracted_pairs(joined, solid))
 
 
 def sampled_joints(robot: Robot) -> list[tuple[str, float, float]]:

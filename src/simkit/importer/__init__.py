@@ -35,6 +35,7 @@ from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.draft import DENSITY, Draft, Options, Unresolvable
 from simkit.importer.fixups import names, step_budget
 from simkit.importer.formats import Format
+from simkit.importer.translate import loops
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.write.output import staging
 
@@ -49,8 +50,8 @@ def steps(fmt: Format) -> tuple[Callable[[Draft], None], ...]:
     """The import's steps for a file of format `fmt`, in order: each receives the draft
     and changes it."""
     return (
-        translate.to_spec, names.legal, *fmt.edits, _refused, step_budget.fit,
-        *fixups.STEPS, *fmt.after,
+        translate.to_spec, names.legal, loops.close, *fmt.edits, _refused, step_budget.fit,
+        *fixups.STEPS, loops.at_home, *fmt.after,
     )  # fmt: skip
 
 

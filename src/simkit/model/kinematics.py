@@ -185,10 +185,12 @@ def contracted_pairs(joined: Iterable[tuple[str, str]], solid: set[str]) -> set[
 
 
 def jointed_pairs(robot: Robot) -> list[tuple[str, str]]:
-    """Parent-child link pairs joined directly by a joint, in joint order: the pairs whose
-    contacts the MJCF and USD exclude (MoveIt's wider `adjacent_pairs` is a derive step)."""
+    """Parent-child link pairs joined directly by a joint, in joint order, then the pairs a
+    loop closure joins (spec `loops`, in order): the pairs whose contacts the MJCF and USD
+    exclude (MoveIt's wider `adjacent_pairs` is a derive step)."""
     links = {link.name for link in robot.links}
-    return [(j.parent, j.child) for j in robot.joints if j.parent in links]
+    pairs = [(j.parent, j.child) for j in robot.joints if j.parent in links]
+    return pairs + [(lp.link1, lp.link2) for lp in robot.loops if {lp.link1, lp.link2} <= links]
 
 
 def excluded_pairs(robot: Robot) -> list[tuple[str, str]]:

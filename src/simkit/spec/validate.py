@@ -16,6 +16,7 @@ from pydantic import ValidationError
 
 from simkit.errors import SpecError
 from simkit.spec import bounds as spec_bounds
+from simkit.spec import loops as spec_loops
 from simkit.spec import mjcf as spec_mjcf
 from simkit.spec import names as spec_names
 from simkit.spec import sim as spec_sim
@@ -204,6 +205,7 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield (key,), f"unknown link or frame '{value}'"
     yield from _planning_groups(spec)
     yield from _contact_excludes(spec)
+    yield from spec_loops.problems(spec)
     for k, field in enumerate(spec.published.estimated):
         if field not in ESTIMABLE_ROBOT:
             yield ("published", "estimated", k), f"'{field}' is not a published figure"
