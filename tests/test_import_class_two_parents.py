@@ -12,6 +12,8 @@ import json
 import pytest
 import yaml
 
+from simkit.check.kit import Kit
+from simkit.check.loops import check_loops
 from simkit.importer import import_robot
 from urdf_parts import joint, link, write
 
@@ -63,6 +65,16 @@ def test_the_looped_robot_builds_a_checked_kit(tmp_path, frame):
 
     done = import_robot(_looped(tmp_path, frame), tmp_path / "out")
     result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
-    assert any(f.check == "source.joints" and f.ok for f in result.findings)
+    passed = {f.check for f in result.findings if f.ok}
+    assert {"source.joints", "loops.mjcf", "loops.hold", "usd.loops"} <= passed
     robot = json.loads((result.kit_dir / "robot.json").read_text())
     assert any(d["what"] == "joints.tip_to_base" for d in robot["source_differences"])
+    # the tip 0.4 m above the base, which the world mount lifts 0.2 m (MuJoCo's world body)
+    body1, z = ("base", "0.4") if frame == "base" else ("world", "0.6")
+    mjcf = result.kit_dir / "mjcf/looped.xml"
+    text = mjcf.read_text()
+    weld = f'<weld name="tip_to_base" body1="{body1}" body2="tip" relpose="0 0 {z} '
+    assert weld in text
+    mjcf.write_text(text.replace(weld, weld.replace(z, z + "1")))  # tampered by 1 cm
+    failed = [f.check for f in check_loops(Kit.open(result.kit_dir)) if not f.ok]
+    assert failed == ["loops.mjcf"]

@@ -35,8 +35,8 @@ from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.draft import DENSITY, Draft, Options, Unresolvable
 from simkit.importer.fixups import names, step_budget
 from simkit.importer.formats import Format
-from simkit.importer.translate import loops
 from simkit.importer.read.options import ReadOptions
+from simkit.importer.translate import loops
 from simkit.importer.write.output import staging
 
 

@@ -15,6 +15,7 @@ import math
 from collections.abc import Iterator
 from typing import Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, model_validator
 
 # Own base types (not imported from schema.py, which imports this module).
@@ -23,6 +24,8 @@ Problem = tuple[tuple, str]
 
 #: closure types a spec may name: a weld holds position and orientation
 TYPES = ("weld",)
+#: m and rad: how far a named pose may put link2 from its loop pose (the spec's own rounding)
+POSE_TOL = 1e-6
 
 
 class LoopSpec(BaseModel):
@@ -84,3 +87,74 @@ def problems(spec) -> Iterator[Problem]:
         elif pair in pairs:
             yield ("loops", i, "link2"), f"'{loop.link1}' and '{loop.link2}' are closed twice"
         pairs.add(pair)
+
+
+def _rot(rpy) -> np.ndarray:
+    """R = Rz(yaw) Ry(pitch) Rx(roll), URDF's convention (model/kinematics.rpy_matrix)."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(r),
+        math.sin(r),
+        math.cos(p),
+        math.sin(p),
+        math.cos(y),
+        math.sin(y),
+    )
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def _placed(xyz, rot) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3], out[:3, 3] = rot, xyz
+    return out
+
+
+def _forward(joints, root: str, values: dict[str, float]) -> dict[str, np.ndarray]:
+    """T_root_link of every link at joint `values` (rad or m; 0 where none), the joints in
+    depth-first order."""
+    poses = {root: np.eye(4)}
+    for joint in joints:
+        motion = np.eye(4)
+        q = values.get(joint.name, 0.0)
+        axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
+        if joint.type == "prismatic":
+            motion[:3, 3] = axis * q
+        elif joint.type in ("revolute", "continuous"):
+            k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+            motion[:3, :3] = np.eye(3) + math.sin(q) * k + (1 - math.cos(q)) * k @ k
+        origin = _placed(joint.xyz, _rot(joint.rpy_rad()))
+        poses[joint.child] = poses[joint.parent] @ origin @ motion
+    return poses
+
+
+def pose_problems(spec, joints) -> Iterator[Problem]:
+    """Every named pose (`home` at least: all joints at 0 without one) keeps each loop
+    closed: the tree puts `link2` at the loop's pose in `link1`'s frame. `joints`: the
+    spec's joints depth-first (the order pose values follow)."""
+    if not spec.loops:
+        return
+    movable = [j.name for j in joints if j.movable]
+    named = {name: list(values) for name, values in spec.poses.items()}
+    named.update({n: [math.radians(v) for v in q] for n, q in spec.poses_deg.items()})
+    named.setdefault("home", [0.0] * len(movable))
+    for pose, values in named.items():
+        poses = _forward(joints, spec.root, dict(zip(movable, values, strict=True)))
+        for i, loop in enumerate(spec.loops):
+            want = _placed(loop.xyz, _rot(loop.rpy_rad()))
+            got = np.linalg.inv(poses[loop.link1]) @ poses[loop.link2]
+            gap = float(np.linalg.norm(want[:3, 3] - got[:3, 3]))
+            cos = (np.trace(want[:3, :3].T @ got[:3, :3]) - 1) / 2
+            turn = float(np.arccos(np.clip(cos, -1.0, 1.0)))
+            if max(gap, turn) > POSE_TOL:
+                yield (
+                    ("loops", i, "xyz"),
+                    f"pose '{pose}' puts '{loop.link2}' {gap:.3g} m and {turn:.3g} rad from "
+                    f"the loop's pose in '{loop.link1}''s frame (the loop must be closed in "
+                    "every named pose)",
+                )

@@ -339,8 +339,10 @@ def validate(doc: SourceDoc) -> RobotSpec:
 
 
 def _pose_limits(spec: RobotSpec) -> Iterator[Problem]:
-    """Every named pose lies within the joint limits. Pose values follow the model's joint
-    order (depth-first, `resolve.py`), as `Robot.pose` reads them."""
+    """Every named pose lies within the joint limits and keeps each loop closed
+    (spec/loops.py). Pose values follow the model's joint order (depth-first,
+    `resolve.py`), as `Robot.pose` reads them."""
+    yield from spec_loops.pose_problems(spec, depth_first(spec.joints, spec.root))
     joints = [j for j in depth_first(spec.joints, spec.root) if j.movable]
     for key, scale in (("poses", 1.0), ("poses_deg", math.pi / 180)):
         for pose, values in getattr(spec, key).items():

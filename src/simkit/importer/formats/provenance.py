@@ -120,7 +120,7 @@ def _loops(source: Source, report: Said, add) -> None:
         child = joint.find("child")
         link = None if child is None else child.get("link")
         if link in parented:
-            said = _said(report, source, joint) or "a second parent joint: a closed loop, closed by a weld"
+            said = _said(report, source, joint) or "a second parent joint: closed by a weld"
             add(f"joints.{joint.get('name')}", said)
         parented.add(link)
 
