@@ -17,7 +17,9 @@ the readers of other formats call it too):
   `source_differences` (`joints.J`, formats/provenance.py), closed by a weld.
 
 A closure between two links a joint joins already (a second joint between the same two
-links) has no loop to close: it is left out, and so is one whose link the kit dropped.
+links) has no loop to close: it is left out with one report line, and so is one whose link
+the kit dropped. A format's own closure element (an MJCF `<weld>`, formats/mjcf/welds.py)
+is listed in `source_differences` under its key, closed or left out.
 """
 
 from __future__ import annotations
@@ -72,11 +74,20 @@ def close(draft: Draft) -> None:
             new = renamed.get("links", {}).get(old) or renamed.get("frames", {}).get(old) or old
             ends.append(holders.get(new, new))
         link1, link2 = ends
-        if not _closable(draft.spec, link1, link2):
+        why = _unclosable(draft.spec, link1, link2)
+        listed = joint.get("listed")  # a format's own element (an MJCF weld), listed so
+        if why:
+            draft.report.dropped(draft.source, joint, f"a closed loop with {why}")
+            if listed:
+                draft.listed.append((listed, f"left out: {why}"))
             continue
         name = _free(renamed.get("joints", {}).get(joint.get("name")) or joint.get("name"), names)
         names.add(name)
         loops.append({"name": name, "type": "weld", "link1": link1, "link2": link2})
+        if listed:
+            said = f"closed by a weld (spec `loops` '{name}') at the pose the tree gives at home"
+            draft.report.changed(draft.source, joint, f"'{link2}' welded to '{link1}': {said}")
+            draft.listed.append((listed, said))
     if loops:
         draft.spec["loops"] = loops
         draft.changed()
@@ -115,12 +126,18 @@ def _holders(spec: dict) -> dict[str, str]:
     return out
 
 
-def _closable(spec: dict, a: str | None, b: str | None) -> bool:
-    """Two different links (or the root) a joint does not join already."""
+def _unclosable(spec: dict, a: str | None, b: str | None) -> str:
+    """Why no loop joins `a` and `b` ("" when one does): two different links (or the root)
+    that no joint joins already."""
     known = {link["name"] for link in spec["links"]} | {spec.get("root")}
-    if a not in known or b not in known or a == b:
-        return False
-    return not any({j["parent"], j["child"]} == {a, b} for j in spec["joints"])
+    missing = [n for n in (a, b) if n not in known]
+    if missing:
+        return f"'{missing[0]}', which is no link of the kit: no loop to close"
+    if a == b:
+        return f"'{a}' itself: no loop to close"
+    if any({j["parent"], j["child"]} == {a, b} for j in spec["joints"]):
+        return f"'{a}' and '{b}' joined by a joint already: no loop to close"
+    return ""
 
 
 def _free(name: str, taken: set[str]) -> str:

@@ -1,0 +1,62 @@
+"""An MJCF `<equality><weld>` between two bodies of the robot closes a kinematic loop (issue
+42, class 8): the import carries it as a spec `loops` weld, at the pose the tree gives at
+home, by the rule a URDF link with two parents follows (importer/translate/loops.py), and
+lists it as closed; a `<connect>` (a ball closure) stays listed as left out."""
+
+from __future__ import annotations
+
+import pytest
+
+from mjcf_models import listed, spec_of, write
+
+LINK = (
+    '<inertial pos="0 0 0.1" mass="0.5" diaginertia="2e-3 2e-3 5e-4"/>'
+    '<geom type="capsule" fromto="0 0 0 0 0 0.2" size="0.02"/>'
+)
+#: a two-link arm and a strut beside it, both on the base; the strut's tip welded to the
+#: forearm (`tie`), the strut pinned to the upper arm too (`pin`, a connect)
+STRUT = f"""<mujoco model="strut">
+  <worldbody>
+    <body name="base"><inertial pos="0 0 0" mass="2" diaginertia="1e-2 1e-2 1e-2"/>
+      <geom type="box" size="0.05 0.05 0.02"/>
+      <body name="upper" pos="0 0 0.02"><joint name="shoulder" axis="0 1 0" range="-1 1"/>{LINK}
+        <body name="fore" pos="0 0 0.2"><joint name="elbow" axis="0 1 0" range="-1 1"/>{LINK}
+        </body>
+      </body>
+      <body name="strut" pos="0.1 0 0.02"><joint name="strut_j" axis="0 1 0" range="-1 1"/>{LINK}
+      </body>
+    </body>
+  </worldbody>
+  <equality>
+    <weld name="tie" body1="fore" body2="strut"/>
+    <connect name="pin" body1="upper" body2="strut" anchor="0 0 0.1"/>{{more}}
+  </equality>
+</mujoco>
+"""
+
+
+def test_a_body_weld_becomes_a_loop_and_a_connect_stays_listed(tmp_path):
+    spec = spec_of(
+        write(tmp_path / "src", STRUT.replace("{more}", ""), "strut.xml"), tmp_path / "o"
+    )
+    (loop,) = spec["loops"]
+    assert (loop["name"], loop["type"], loop["link1"], loop["link2"]) == (
+        "tie",
+        "weld",
+        "fore",
+        "strut",
+    )
+    # at home (all joints 0) the strut's frame is 0.1 m out and 0.2 m below the forearm's
+    assert loop["xyz"] == pytest.approx([0.1, 0, -0.2]) and loop["rpy"] == [0, 0, 0]
+    said = listed(spec)
+    assert "closed by a weld" in said["equality.tie"]
+    assert "closed" not in said["equality.pin"]
+
+
+def test_a_weld_the_tree_holds_already_stays_listed(tmp_path):
+    more = '\n    <weld name="twice" body1="upper" body2="fore"/>'
+    spec = spec_of(
+        write(tmp_path / "src", STRUT.replace("{more}", more), "strut.xml"), tmp_path / "o"
+    )
+    assert [lp["name"] for lp in spec["loops"]] == ["tie"]
+    assert "joined by a joint already" in listed(spec)["equality.twice"]
