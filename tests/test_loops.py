@@ -96,12 +96,29 @@ def test_the_same_pair_closed_twice_is_refused(tmp_path):
         load_spec(path)
 
 
+#: a bar under the forearm (fixed to it) that rests on the base at home only: the forearm
+#: welded to the base, the bar touches the base where the loop holds the robot
+BRACKET = {
+    "name": "bracket",
+    "mass": 0.1,
+    "solid": [{"shape": "box", "size": [0.3, 0.02, 0.02], "xyz": [-0.15, 0, -0.035]}],
+    "collision": "convex",
+}
+
+
 @pytest.fixture(scope="module")
 def welded(tmp_path_factory):
     from simkit.pipeline import build
 
     folder = tmp_path_factory.mktemp("loops")
-    return build(str(_spec(folder, [STRUT], "strut_2r")), folder / "kits")
+    path = _spec(folder, [STRUT], "strut_2r")
+    data = yaml.safe_load(path.read_text())
+    data["links"][0]["collision"] = "convex"  # the base collides in the kit
+    data["links"].append(BRACKET)
+    bar = {"name": "bracket_joint", "type": "fixed", "parent": "link_2", "child": "bracket"}
+    data["joints"].append(bar)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return build(str(path), folder / "kits")
 
 
 @pytest.mark.slow
@@ -110,20 +127,23 @@ def test_every_format_carries_the_loop_and_the_kit_passes(welded):
 
     assert not [f.line() for f in welded.findings if not f.ok]
     passed = {f.check for f in welded.findings if f.ok}
-    assert {"loops.home", "loops.mjcf", "loops.hold", "usd.loops"} <= passed
+    assert {"loops.home", "loops.mjcf", "loops.hold", "loops.pairs", "usd.loops"} <= passed
     kit = welded.kit_dir
     mjcf = (kit / "mjcf/strut_2r.xml").read_text()
     assert (
         '<weld name="strut" body1="base_link" body2="link_2" relpose="0.3 0 0.08 1 0 0 0"' in mjcf
     )
     assert '<exclude body1="base_link" body2="link_2" />' in mjcf
+    assert '<exclude body1="base_link" body2="bracket" />' in mjcf  # touching at home
     assert "<weld" in (kit / "mjcf/strut_2r_mjx.xml").read_text()
     for file in ("urdf/strut_2r.urdf", "sdf/strut_2r.sdf"):
         assert "loop 'strut' (weld)" in (kit / file).read_text()
     srdf = (kit / "srdf/strut_2r.srdf").read_text()
     assert '<disable_collisions link1="base_link" link2="link_2" reason="Adjacent" />' in srdf
+    assert '<disable_collisions link1="base_link" link2="bracket" reason="Default" />' in srdf
     doc = json.loads((kit / "robot.json").read_text())
     assert [lp["name"] for lp in doc["loops"]] == ["strut"]
+    assert doc["collision_pairs"]["loop"] == [["base_link", "bracket"]]
     assert "Closed loops" in (kit / "README.md").read_text()
     stage = Usd.Stage.Open(str(kit / layout.usd_payload("strut_2r", "physics.usda")))
     joint = UsdPhysics.FixedJoint(stage.GetPrimAtPath("/strut_2r/joints/strut"))
@@ -156,3 +176,14 @@ def test_a_tampered_relpose_fails(welded, tmp_path):
     kit = _tampered(welded, tmp_path / "both", weld, 'relpose="0.3 0 0.085 1 0 0 0"', 0.085)
     failed = {f.check for f in check_loops(kit) if not f.ok}
     assert "loops.home" in failed
+
+
+@pytest.mark.slow
+def test_a_pair_excluded_around_a_loop_must_touch_at_home(welded, tmp_path):
+    kit = tmp_path / "kit"
+    shutil.copytree(welded.kit_dir, kit)
+    doc = json.loads((kit / "robot.json").read_text())
+    doc["collision_pairs"]["loop"].append(["link_1", "bracket"])  # 5 mm apart at home
+    (kit / "robot.json").write_text(json.dumps(doc))
+    (finding,) = [f for f in check_loops(Kit.open(kit)) if f.check == "loops.pairs"]
+    assert not finding.ok and "link_1-bracket: apart at home" in finding.detail

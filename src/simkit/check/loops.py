@@ -9,6 +9,8 @@ robot.json lists each loop (`loops`: link2's pose in link1's frame at home). The
 - `loops.hold`: MuJoCo, on the MJCF with the position servos, starts at home with the
   servos aimed at home and runs `HOLD_SECONDS`: each loop's link2 stays within `HOLD_M` /
   `HOLD_RAD` of its pose in link1's frame (a tampered relpose pulls the robot away);
+- `loops.pairs`: each pair robot.json excludes around a loop (`collision_pairs.loop`) sits
+  around one and touches at home in the MJCF;
 - `usd_findings` (called by check/usd.py per physics variant): the USD's joints excluded
   from the articulation are exactly the loops, between the same bodies at the same pose.
 
@@ -32,6 +34,8 @@ HOLD_M = 1e-3
 HOLD_RAD = 0.01
 #: m / rad: a written pose matches robot.json's (10-digit numbers in both files)
 POSE_TOL = 1e-6
+#: m: a pair excluded around a loop is closer than this at home (float32 mesh files)
+TOUCH = 1e-5
 
 
 def _loops(kit: Kit) -> list[dict]:
@@ -60,7 +64,43 @@ def check_loops(kit: Kit) -> list[Finding]:
     findings = [_home(kit, loops), _mjcf(kit, mj, welds, loops)]
     if findings[-1].ok:
         findings.append(_hold(kit, loops))
+    pairs = (kit.doc.get("collision_pairs") or {}).get("loop", [])
+    if pairs:
+        findings.append(_pairs(kit, mj, pairs, loops))
     return findings
+
+
+def _pairs(kit: Kit, mj, pairs: list, loops: list[dict]) -> Finding:
+    """`loops.pairs`: each pair robot.json excludes around a loop (`collision_pairs.loop`)
+    joins a welded link or its neighbour (by robot.json's joints or loops) to the other
+    welded link or its neighbour, and touches at home in the MJCF (within `TOUCH`)."""
+    from simkit.check.always import _depth, _geoms
+
+    near: dict[str, set[str]] = {}
+    joined = [(j["parent"], j["child"]) for j in kit.joints + kit.doc.get("fixed_joints", [])]
+    for a, b in joined + [(lp["link1"], lp["link2"]) for lp in loops]:
+        near.setdefault(a, {a}).add(b)
+        near.setdefault(b, {b}).add(a)
+    data = mujoco.MjData(mj)
+    for joint, value in zip(kit.joints, kit.doc.get("home") or [], strict=False):
+        data.qpos[mj.jnt_qposadr[mj.joint(joint["name"]).id]] = value
+    mujoco.mj_kinematics(mj, data)
+    wrong = []
+    for a, b in pairs:
+        around = any(
+            (a in near.get(lp["link1"], ()) and b in near.get(lp["link2"], ()))
+            or (b in near.get(lp["link1"], ()) and a in near.get(lp["link2"], ()))
+            for lp in loops
+        )
+        if not around:
+            wrong.append(f"{a}-{b}: not around a loop")
+        elif _depth(mj, data, _geoms(mj, a), _geoms(mj, b), TOUCH) < -TOUCH:
+            wrong.append(f"{a}-{b}: apart at home")
+    return require(
+        "loops.pairs",
+        not wrong,
+        "pairs excluded around a loop touch at home" + (f"; {'; '.join(wrong)}" if wrong else ""),
+    )
 
 
 def _home(kit: Kit, loops: list[dict]) -> Finding:

@@ -196,7 +196,8 @@ def jointed_pairs(robot: Robot) -> list[tuple[str, str]]:
 def excluded_pairs(robot: Robot) -> list[tuple[str, str]]:
     """The link pairs the kit excludes from contact besides `jointed_pairs`: the derived
     `collision_pairs.always` pairs (in contact in every configuration), then `declared`
-    ones (the spec's `contact_excludes`, which the source excludes); each sorted. The MJCF
+    ones (the spec's `contact_excludes`, which the source excludes), then `loop` ones (in
+    contact at home around a loop closure, collision_pairs.loop_pairs); each sorted. The MJCF
     `<exclude>`s, the USD filtered pairs and the GPU scene take them."""
     block = robot.products.collision_pairs or {}
-    return [(a, b) for key in ("always", "declared") for a, b in block.get(key, [])]
+    return [(a, b) for key in ("always", "declared", "loop") for a, b in block.get(key, [])]
