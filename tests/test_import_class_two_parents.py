@@ -14,6 +14,7 @@ import yaml
 
 from simkit.check.kit import Kit
 from simkit.check.loops import check_loops
+from simkit.check.source import check_source
 from simkit.importer import import_robot
 from urdf_parts import joint, link, write
 
@@ -66,7 +67,7 @@ def test_the_looped_robot_builds_a_checked_kit(tmp_path, frame):
     done = import_robot(_looped(tmp_path, frame), tmp_path / "out")
     result = build(str(done.spec_path), tmp_path / "kits")  # CheckFailed on any failure
     passed = {f.check for f in result.findings if f.ok}
-    assert {"source.joints", "loops.mjcf", "loops.hold", "usd.loops"} <= passed
+    assert {"source.joints", "source.loops", "loops.mjcf", "loops.hold", "usd.loops"} <= passed
     robot = json.loads((result.kit_dir / "robot.json").read_text())
     assert any(d["what"] == "joints.tip_to_base" for d in robot["source_differences"])
     # the tip 0.4 m above the base, which the world mount lifts 0.2 m (MuJoCo's world body)
@@ -78,3 +79,10 @@ def test_the_looped_robot_builds_a_checked_kit(tmp_path, frame):
     mjcf.write_text(text.replace(weld, weld.replace(z, z + "1")))  # tampered by 1 cm
     failed = [f.check for f in check_loops(Kit.open(result.kit_dir)) if not f.ok]
     assert failed == ["loops.mjcf"]
+    # robot.json's loop moved to another link: the source check compares it with the source
+    doc = json.loads((result.kit_dir / "robot.json").read_text())
+    doc["loops"][0]["link1"] = "upper"
+    (result.kit_dir / "robot.json").write_text(json.dumps(doc))
+    kept = done.spec_path.parent / "looped.source.urdf"
+    (finding,) = [f for f in check_source(Kit.open(result.kit_dir, kept)) if "loops" in f.check]
+    assert not finding.ok and "joins 'upper' and 'tip'" in finding.detail
