@@ -59,6 +59,15 @@ def test_the_first_joint_builds_the_tree_and_the_second_is_listed(tmp_path):
     assert loop["rpy"] == pytest.approx([0, 0, 1.0], abs=1e-9)
 
 
+def test_a_loop_named_outside_the_name_grammar_is_spelled_in_it(tmp_path):
+    urdf = _looped(tmp_path).read_text().replace('"tip_to_base"', '"tip-to/base"')
+    (tmp_path / "looped.urdf").write_text(urdf)
+    done = import_robot(tmp_path / "looped.urdf", tmp_path / "out")
+    spec = yaml.safe_load(done.spec_path.read_text())
+    assert [loop["name"] for loop in spec["loops"]] == ["tip_to_base"]
+    assert "joints.tip-to/base" in {d["what"] for d in spec["source_differences"]}
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("frame", ["base", "world"])
 def test_the_looped_robot_builds_a_checked_kit(tmp_path, frame):

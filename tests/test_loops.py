@@ -62,6 +62,7 @@ def test_a_loop_is_read_into_the_model(tmp_path):
         ({"link2": "base_link"}, "loops[0].link2", "not 'base_link' to itself"),
         ({"link1": "link_1"}, "loops[0].link2", "joined by a joint"),
         ({"name": "joint_2"}, "loops[0].name", "already used"),
+        ({"name": "strut/1"}, "loops[0].name", "A-Z, a-z, 0-9 and _"),
         ({"type": "hinge"}, "loops[0].type", "'weld'"),
         ({"link_1": "base_link"}, "loops[0].link_1", "unknown field; did you mean 'link1'?"),
     ],

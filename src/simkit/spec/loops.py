@@ -18,6 +18,8 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, model_validator
 
+from simkit.spec.names import name_problem
+
 # Own base types (not imported from schema.py, which imports this module).
 Vec3 = tuple[float, float, float]
 Problem = tuple[tuple, str]
@@ -70,7 +72,10 @@ def problems(spec) -> Iterator[Problem]:
     names = {j.name for j in spec.joints}
     pairs: set[frozenset] = set()
     for i, loop in enumerate(spec.loops):
-        if loop.name in names:
+        why = name_problem(loop.name)
+        if why:
+            yield ("loops", i, "name"), why
+        elif loop.name in names:
             yield ("loops", i, "name"), f"name '{loop.name}' is already used by a joint or loop"
         names.add(loop.name)
         bad = [(f, n) for f, n in (("link1", loop.link1), ("link2", loop.link2)) if n not in known]

@@ -2,11 +2,10 @@
 
 A source joint whose child link already hangs from an earlier joint (a second parent, in
 the source's joint order) closes a loop: the kit keeps the tree from the first joint and
-may close the loop with a weld named as the joint (importer/translate/loops.py). Each
-robot.json loop of a source joint's name must join that joint's parent and child (kit
-names: renamed as listed, a frame by the link it hangs from), and each robot.json loop
-no source joint accounts for must be listed (`loops.NAME`). A kit without loops gets no
-finding.
+closes the loop with a weld from the joint's parent to its child
+(importer/translate/loops.py). Each robot.json loop must join the parent and child of such
+a source joint (kit names: renamed as listed, a frame by the link it hangs from), or be
+listed (`loops.NAME`). A kit without loops gets no finding.
 """
 
 from __future__ import annotations
@@ -38,22 +37,17 @@ def compare(joints, doc: dict, allowed: Allowed) -> list[Finding]:
         for name, f in (doc.get("frames") or {}).items()
         if name not in links
     }
-    closing = second_parents(joints)
-    problems = []
-    for loop in loops:
-        name = loop["name"]
-        source = next((n for n in closing if allowed.joints.get(n, n) == name), None)
-        if source is None:
-            if f"loops.{name}" not in allowed.keys:
-                problems.append(f"loop '{name}' closes no loop of the source")
-            continue
-        ends = [allowed.links.get(n, n) for n in closing[source]]
-        ends = [holder.get(n, n) for n in ends]
-        if ends != [loop["link1"], loop["link2"]]:
-            problems.append(
-                f"loop '{name}' joins '{loop['link1']}' and '{loop['link2']}', the source's "
-                f"joint '{source}' '{ends[0]}' and '{ends[1]}'"
-            )
+    closing = {
+        tuple(holder.get(allowed.links.get(n, n), allowed.links.get(n, n)) for n in ends)
+        for ends in second_parents(joints).values()
+    }
+    problems = [
+        f"loop '{loop['name']}' joins '{loop['link1']}' and '{loop['link2']}': no second "
+        "parent joint of the source does"
+        for loop in loops
+        if (loop["link1"], loop["link2"]) not in closing
+        and f"loops.{loop['name']}" not in allowed.keys
+    ]
     return [
         require(
             "source.loops",

@@ -24,12 +24,15 @@ is listed in `source_differences` under its key, closed or left out.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from simkit.importer.diagnostics import Report
 from simkit.importer.draft import Draft
 from simkit.importer.read.source import Source
 from simkit.model.kinematics import forward, matrix_rpy
+from simkit.spec.names import MAX_NAME, name_problem
 
 
 def second_parents(source: Source, report: Report) -> None:
@@ -141,7 +144,11 @@ def _unclosable(spec: dict, a: str | None, b: str | None) -> str:
 
 
 def _free(name: str, taken: set[str]) -> str:
-    """`name`, or `name_loop`, `name_loop2`, ... where a joint or loop has it."""
+    """`name` in the spec's name grammar (other characters `_`, a leading digit after an
+    `n`), or `name_loop`, `name_loop2`, ... where a joint or loop has it."""
+    if name_problem(name):
+        name = re.sub(r"[^A-Za-z0-9_]", "_", name) or "loop"
+        name = (name if not name[0].isdigit() else f"n{name}")[: MAX_NAME - 8]
     if name not in taken:
         return name
     out, n = f"{name}_loop", 2
