@@ -60,3 +60,24 @@ def test_a_weld_the_tree_holds_already_stays_listed(tmp_path):
     )
     assert [lp["name"] for lp in spec["loops"]] == ["tie"]
     assert "joined by a joint already" in listed(spec)["equality.twice"]
+
+
+@pytest.mark.slow
+def test_the_welded_strut_builds_a_checked_kit_and_the_source_check_compares_it(tmp_path):
+    import json
+
+    from simkit.check.kit import Kit
+    from simkit.check.source import check_source
+    from simkit.pipeline import build
+
+    write(tmp_path / "src", STRUT.replace("{more}", ""), "strut.xml")
+    spec_of(tmp_path / "src" / "strut.xml", tmp_path / "o")
+    result = build(str(tmp_path / "o" / "strut.yaml"), tmp_path / "kits")  # CheckFailed if not
+    passed = {f.check for f in result.findings if f.ok}
+    assert {"source.loops", "loops.mjcf", "loops.hold", "usd.loops"} <= passed
+    doc = json.loads((result.kit_dir / "robot.json").read_text())
+    doc["loops"][0]["link1"] = "upper"  # tampered: no weld of the source joins upper
+    (result.kit_dir / "robot.json").write_text(json.dumps(doc))
+    kit = Kit.open(result.kit_dir, tmp_path / "o" / "strut.source.xml")
+    (finding,) = [f for f in check_source(kit) if f.check == "source.loops"]
+    assert not finding.ok and "no body weld of the source" in finding.detail

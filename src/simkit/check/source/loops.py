@@ -56,3 +56,40 @@ def compare(joints, doc: dict, allowed: Allowed) -> list[Finding]:
             or f"{len(loops)} loop(s): each closes a second parent joint of the source",
         )
     ]
+
+
+#: mjtEq, mjtObj
+WELD, BODY = 1, 1
+
+
+def compare_mjcf(pairs, doc: dict) -> list[Finding]:
+    """`source.loops` of an MJCF source: each robot.json loop is a body `<weld>` of the
+    source between the same bodies (the kit's names; the root: MuJoCo's world), or listed
+    (`loops.NAME`). `pairs`: check/source/mjcf.py's source -> kit pairing."""
+    loops = doc.get("loops") or []
+    if not loops:
+        return []
+    s, k = pairs.source, pairs.kit
+    welds = set()
+    for e in range(int(s.neq)):
+        if int(s.eq_type[e]) != WELD or int(s.eq_objtype[e]) != BODY:
+            continue
+        ends = (int(s.eq_obj1id[e]), int(s.eq_obj2id[e]))
+        ids = [pairs.kit_id("body", s.body(b).name) if b else 0 for b in ends]
+        if min(ids) >= 0:
+            welds.add(tuple(k.body(i).name for i in ids))
+    links = {link["name"] for link in doc.get("links", [])}
+    problems = [
+        f"loop '{loop['name']}' joins '{loop['link1']}' and '{loop['link2']}': no body weld "
+        "of the source does"
+        for loop in loops
+        if tuple(n if n in links else "world" for n in (loop["link1"], loop["link2"])) not in welds
+        and not pairs.listed(f"loops.{loop['name']}")
+    ]
+    return [
+        require(
+            "source.loops",
+            not problems,
+            "; ".join(problems) or f"{len(loops)} loop(s): each is a body weld of the source",
+        )
+    ]
