@@ -59,6 +59,21 @@ def test_the_first_joint_builds_the_tree_and_the_second_is_listed(tmp_path):
     assert loop["rpy"] == pytest.approx([0, 0, 1.0], abs=1e-9)
 
 
+def test_a_movable_second_joint_is_said_to_be_locked(tmp_path):
+    urdf = _looped(tmp_path).read_text()
+    second = urdf[urdf.index('<joint name="tip_to_base"') :]
+    pinned = second.replace('type="fixed"', 'type="revolute"').replace(
+        "</joint>", '<limit lower="-1" upper="1" effort="5" velocity="1"/></joint>'
+    )
+    (tmp_path / "looped.urdf").write_text(urdf.replace(second, pinned))
+    done = import_robot(tmp_path / "looped.urdf", tmp_path / "out")
+    (said,) = [line for line in done.lines if "closed loop" in line]
+    assert "its revolute motion is locked" in said
+    assert [lp["name"] for lp in yaml.safe_load(done.spec_path.read_text())["loops"]] == [
+        "tip_to_base"
+    ]
+
+
 def test_a_loop_named_outside_the_name_grammar_is_spelled_in_it(tmp_path):
     urdf = _looped(tmp_path).read_text().replace('"tip_to_base"', '"tip-to/base"')
     (tmp_path / "looped.urdf").write_text(urdf)

@@ -48,7 +48,11 @@ def second_parents(source: Source, report: Report) -> None:
         if link not in first:
             first[link] = joint
             continue
-        report.changed(source, joint, loop_reason(first[link], link))
+        said = loop_reason(first[link], link)
+        kind = joint.get("type") or "fixed"
+        if kind != "fixed":  # a four-bar's pin: the kit holds it rigid (no `connect` yet)
+            said += f"; its {kind} motion is locked (a weld holds all six degrees of freedom)"
+        report.changed(source, joint, said)
         source.closures.append(joint)
         source.root.remove(joint)
 
