@@ -188,3 +188,15 @@ def test_a_pair_excluded_around_a_loop_must_touch_at_home(welded, tmp_path):
     (kit / "robot.json").write_text(json.dumps(doc))
     (finding,) = [f for f in check_loops(Kit.open(kit)) if f.check == "loops.pairs"]
     assert not finding.ok and "link_1-bracket: apart at home" in finding.detail
+
+
+@pytest.mark.slow
+def test_a_weld_robot_json_does_not_list_fails(welded, tmp_path):
+    kit = tmp_path / "kit"
+    shutil.copytree(welded.kit_dir, kit)
+    doc = json.loads((kit / "robot.json").read_text())
+    del doc["loops"]
+    (kit / "robot.json").write_text(json.dumps(doc))
+    failed = {f.check: f.detail for f in check_loops(Kit.open(kit)) if not f.ok}
+    assert "MJCF welds ['strut'] are not robot.json's loops []" in failed["loops.mjcf"]
+    assert "not around a loop" in failed["loops.pairs"]  # its excluded pair too
