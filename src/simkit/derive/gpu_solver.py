@@ -106,7 +106,7 @@ def _bodies(robot: Robot, root: ET.Element, asset: ET.Element, geoms: list[dict]
 
 
 def _tail(robot: Robot, root: ET.Element, timestep: float) -> None:
-    """Mimic equalities and position servos as the kit's MJCF writes them."""
+    """Loop welds, mimic equalities and position servos as the kit's MJCF writes them."""
     mimics = [j for j in robot.joints if j.mimic is not None]
     if mimics or robot.loops:
         equality = ET.SubElement(root, "equality")
