@@ -91,6 +91,16 @@ def test_a_named_pose_that_opens_the_loop_is_refused(tmp_path):
         load_spec(path)
 
 
+def test_a_floating_base_closes_no_loop_on_the_root(tmp_path):
+    path = _spec(tmp_path, [{**STRUT, "link1": "base_footprint", "xyz": [0.3, 0, 0.08]}])
+    data = yaml.safe_load(path.read_text())
+    data["floating_base"] = True
+    data["joints"][0]["type"] = "floating"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(SpecError, match=r"loops\[0\]\.link1: a floating base moves freely"):
+        load_spec(path)
+
+
 def test_the_same_pair_closed_twice_is_refused(tmp_path):
     path = _spec(tmp_path, [STRUT, {**STRUT, "name": "strut2"}])
     with pytest.raises(SpecError, match=r"loops\[1\]\.link2: 'base_link' and 'link_2' are closed"):

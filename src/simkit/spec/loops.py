@@ -84,8 +84,12 @@ def problems(spec) -> Iterator[Problem]:
         pair = frozenset((loop.link1, loop.link2))
         if bad:
             continue
+        floating = spec.floating_base or any(j.type == "floating" for j in spec.joints)
         if loop.link1 == loop.link2:
             yield ("loops", i, "link2"), f"a loop joins two links, not '{loop.link1}' to itself"
+        elif floating and spec.root in pair:
+            why = f"a floating base moves freely: no loop closes on the root '{spec.root}'"
+            yield ("loops", i, "link1" if loop.link1 == spec.root else "link2"), why
         elif pair in jointed:
             why = f"'{loop.link1}' and '{loop.link2}' are joined by a joint: no loop to close"
             yield ("loops", i, "link2"), why

@@ -142,6 +142,8 @@ def _unclosable(spec: dict, a: str | None, b: str | None) -> str:
         return f"'{missing[0]}', which is no link of the kit: no loop to close"
     if a == b:
         return f"'{a}' itself: no loop to close"
+    if spec.get("floating_base") and spec.get("root") in (a, b):
+        return f"the world '{spec.get('root')}', which a floating base does not hang from"
     if any({j["parent"], j["child"]} == {a, b} for j in spec["joints"]):
         return f"'{a}' and '{b}' joined by a joint already: no loop to close"
     return ""
