@@ -15,8 +15,9 @@ typed object every step receives), `read/` (what every reader shares) and `diagn
 
 The import picks the format once (formats.pick: the file's head read once), reads the file,
 then passes one draft through `steps(format)` in order: translate.to_spec, the names made
-legal, the format's edits, the refusals `--strict` asks for, the STEP budget, fixups.STEPS
-(rotors, base, home, stand, limits) and the format's last steps; then the format keeps its
+legal, the closed loops made spec `loops` (translate/loops.py), the format's edits, the
+refusals `--strict` asks for, the STEP budget, fixups.STEPS (rotors, base, home, stand,
+limits), the loops' poses at the final home and the format's last steps; then the format keeps its
 source (`keep`) and `write.finish` writes and validates the spec once and moves the files
 into place whole (write/output.py). The staging folder is removed on every way out.
 """
