@@ -210,3 +210,10 @@ def test_a_weld_robot_json_does_not_list_fails(welded, tmp_path):
     failed = {f.check: f.detail for f in check_loops(Kit.open(kit)) if not f.ok}
     assert "MJCF welds ['strut'] are not robot.json's loops []" in failed["loops.mjcf"]
     assert "not around a loop" in failed["loops.pairs"]  # its excluded pair too
+    from pxr import Usd
+
+    from simkit.check.loops import usd_findings
+
+    stage = Usd.Stage.Open(str(kit / "usd/strut_2r.usda"))
+    (finding,) = usd_findings(Kit.open(kit), stage, "/strut_2r")
+    assert not finding.ok and "excluded joints ['strut'] are not the loops" in finding.detail
