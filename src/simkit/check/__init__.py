@@ -32,6 +32,7 @@ _REGISTRY: dict[str, str] = {
     "ros": "ros:check_ros",
     "hold": "mujoco:check_hold",
     "legged": "legged:check_legged",
+    "loops": "loops:check_loops",
     "usd": "usd:check_usd",
     "motion": "motion:check_motion",
     "freefall": "freefall:check_freefall",

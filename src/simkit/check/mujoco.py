@@ -407,7 +407,13 @@ def _excludes(kit: Kit, mj: mujoco.MjModel) -> Finding:
         if j["parent"] in links and j["child"] in links
     }
     block = kit.doc.get("collision_pairs") or {}
-    adjacent |= {tuple(sorted(p)) for key in ("always", "declared") for p in block.get(key, [])}
+    keys = ("always", "declared", "loop")  # loop: touching at home (check/loops.py)
+    adjacent |= {tuple(sorted(p)) for key in keys for p in block.get(key, [])}
+    adjacent |= {  # a loop closure joins its links as a joint does (robot.json `loops`)
+        tuple(sorted((lp["link1"], lp["link2"])))
+        for lp in kit.doc.get("loops", [])
+        if lp["link1"] in links and lp["link2"] in links
+    }
     apart = not_touching(kit, mj)
     if apart:
         return require("mjcf.excludes", False, f"excluded as always touching but apart: {apart}")

@@ -13,6 +13,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
+from simkit.check.loops import usd_findings as usd_loop_findings
 from simkit.check.mujoco import load_control_mjcf
 from simkit.check.readers.usd import (
     UsdJoint,
@@ -368,6 +369,7 @@ def _physics(kit: Kit, stage, top) -> list[Finding]:
         findings += robot_schema_findings(stage, top, links, [j.path for j in joints])
     if parsed is not None:
         findings += collision_findings(parsed, mj, links)
+    findings += usd_loop_findings(kit, stage, root)
     xforms: dict[str, str] = {}
     for prim in Usd.PrimRange(top):
         if prim.IsA(UsdGeom.Xform):

@@ -49,10 +49,13 @@ def has_geometry(link: Link) -> bool:
 
 
 def adjacent_pairs(robot: Robot) -> list[tuple[str, str]]:
-    """Pairs of links with collision geometry joined by a joint, or by a chain of links and
-    frames without geometry (MoveIt Setup Assistant's connection graph), sorted."""
+    """Pairs of links with collision geometry joined by a joint or a loop closure, or by a
+    chain of links and frames without geometry (MoveIt Setup Assistant's connection graph),
+    sorted."""
     solid = {link.name for link in robot.links if has_geometry(link)}
-    return sorted(contracted_pairs(((j.parent, j.child) for j in robot.joints), solid))
+    joined = [(j.parent, j.child) for j in robot.joints]
+    joined += [(lp.link1, lp.link2) for lp in robot.loops]  # a loop closure joins them too
+    return sorted(contracted_pairs(joined, solid))
 
 
 def sampled_joints(robot: Robot) -> list[tuple[str, float, float]]:
@@ -273,6 +276,36 @@ def always_pairs(
     return sorted(p for p in candidates if count[p] >= need)
 
 
+def loop_pairs(
+    robot: Robot, adjacent: list[tuple[str, str]], known: set[tuple[str, str]]
+) -> list[tuple[str, str]]:
+    """Pairs around a loop closure (spec `loops`) in contact at home: one link a welded link
+    or its neighbour (`adjacent`), the other the other welded link or its neighbour. The
+    sampler moves the joints a weld locks, so it cannot see them; a pair that touches where
+    the loop holds the robot is excluded, as MoveIt's "Default" pairs are. `known` pairs
+    (excluded already) are not tested."""
+    near: dict[str, set[str]] = {}
+    for a, b in adjacent:
+        near.setdefault(a, set()).add(b)
+        near.setdefault(b, set()).add(a)
+    candidates = set()
+    for loop in robot.loops:
+        ends = [{name, *near.get(name, ())} for name in (loop.link1, loop.link2)]
+        candidates |= {tuple(sorted((x, y))) for x in ends[0] for y in ends[1] if x != y}
+    candidates -= set(adjacent) | {tuple(sorted(p)) for p in known}
+    kit = {link.name for link in robot.links if _kit_collides(link)}
+    candidates = {p for p in candidates if set(p) <= kit}
+    if not candidates:
+        return []
+    values = dict(robot.poses).get("home") or [0.0] * len(robot.movable_joints)
+    home = dict(zip([j.name for j in robot.movable_joints], values, strict=True))
+    row = np.array([[home.get(name, 0.0) for name, _, _ in sampled_joints(robot)]])
+    solid = sorted(link.name for link in robot.links if has_geometry(link))
+    others = [p for p in itertools.combinations(solid, 2) if p not in candidates]
+    first = first_contacts(robot, follow_mimics(robot, row), others)
+    return sorted(p for p, index in first.items() if index is not None)
+
+
 def follow_mimics(robot: Robot, q: np.ndarray) -> np.ndarray:
     """`q` (sampled_joints order) with each mimic joint at its leader's value times the
     multiplier plus the offset, as the kit's MJCF equality holds it."""
@@ -316,5 +349,8 @@ def derive_collision_pairs(robot: Robot, samples: int = SAMPLES) -> Robot:
         }
     if declared:
         block["declared"] = [list(p) for p in declared]
+    closing = loop_pairs(robot, adjacent, {*declared, *always})
+    if closing:  # only where the spec closes a loop: other kits are unchanged
+        block["loop"] = [list(p) for p in closing]
     seeds = {**robot.products.seeds, "collision_pairs": seed}
     return replace(robot, products=replace(robot.products, collision_pairs=block, seeds=seeds))

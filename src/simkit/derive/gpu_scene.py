@@ -279,11 +279,11 @@ def pair_slots(kinds: dict[str, str], a: str, b: str, swaps: dict | None = None)
 
 def constraint_rows(robot: Robot, contacts: int) -> int:
     """An upper bound on constraint rows per world: every contact (condim 3, pyramidal), every
-    joint limit, every joint with friction loss, every mimic equality."""
+    joint limit, every joint with friction loss, every mimic equality, six per loop weld."""
     limited = sum(1 for j in robot.movable_joints if j.lower is not None and j.type != "continuous")
     friction = sum(1 for j in robot.movable_joints if j.friction)
     mimics = sum(1 for j in robot.joints if j.mimic is not None)
-    return ROWS_PER_CONTACT * contacts + limited + friction + mimics
+    return ROWS_PER_CONTACT * contacts + limited + friction + mimics + 6 * len(robot.loops)
 
 
 def _colliders_for(robot: Robot, geoms: list[dict], pairs: list, floating: bool) -> dict:

@@ -106,10 +106,22 @@ def _bodies(robot: Robot, root: ET.Element, asset: ET.Element, geoms: list[dict]
 
 
 def _tail(robot: Robot, root: ET.Element, timestep: float) -> None:
-    """Mimic equalities and position servos as the kit's MJCF writes them."""
+    """Loop welds, mimic equalities and position servos as the kit's MJCF writes them."""
     mimics = [j for j in robot.joints if j.mimic is not None]
-    if mimics:
+    if mimics or robot.loops:
         equality = ET.SubElement(root, "equality")
+        for loop in robot.loops:  # as emit/mjcf.py weld_attributes writes them
+            body1, body2 = ("world" if n == robot.root else n for n in (loop.link1, loop.link2))
+            relpose = (*loop.xyz, *quat_wxyz(rpy_matrix(loop.rpy)))
+            ET.SubElement(
+                equality,
+                "weld",
+                body1=body1,
+                body2=body2,
+                relpose=_text(relpose),
+                solref=_text((MIMIC_TIMECONST_STEPS * timestep, 1.0)),
+                solimp=_text(MIMIC_SOLIMP),
+            )
         for joint in mimics:
             leader, multiplier, offset = joint.mimic  # type: ignore[misc]
             ET.SubElement(

@@ -65,6 +65,7 @@ def context(robot: Robot) -> dict:
         "step_origin": step_origin(robot),
         "step_left_out": list(robot.products.step_left_out),
         "segments": CIRCULAR_SEGMENTS,
+        "loops": [f"`{lp.link1}` and `{lp.link2}` ({lp.name})" for lp in robot.loops],
         **_floating(robot),
         **_gpu(robot),
         **training.readme(robot),

@@ -305,6 +305,12 @@ def _generalise(robot: Robot, doc: dict) -> None:
         doc["frames"][robot.root]["role"] = "the world; the floating base moves freely in it"
     if robot.mjcf is not None and robot.mjcf.sensors:
         doc["sensors"] = [s.model_dump(exclude_none=True) for s in robot.mjcf.sensors]
+    if robot.loops:  # closed by the MJCF's welds and the USD's excluded joints (check/loops.py)
+        doc["loops"] = [
+            {"name": lp.name, "type": lp.type, "link1": lp.link1, "link2": lp.link2}
+            | {"origin_xyz": list(lp.xyz), "origin_rpy": list(lp.rpy)}
+            for lp in robot.loops
+        ]
 
 
 def _segments(robot: Robot) -> str:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+from simkit.emit.urdf import loop_comments
 from simkit.kitio import layout
 from simkit.kitio.fmt import num, vec
 from simkit.kitio.xmlwriter import sub, to_bytes
@@ -174,4 +175,5 @@ def emit(robot: Robot) -> dict[str, bytes]:
         parent = _frame_of(robot, frame.parent)
         el = sub(model, "frame", name=frame.name, attached_to=parent)
         _pose(el, frame.xyz, frame.rpy, parent)
+    model.extend(loop_comments(robot, "SDFormat as Drake reads it (a tree)"))
     return {file: to_bytes(root, HEADER.format(spec=robot.spec_file))}

@@ -109,6 +109,8 @@ def emit(robot: Robot) -> dict[str, bytes]:
     disabled += [(a, b, "Always") for a, b in pairs.get("always", [])]
     listed = {(a, b) for a, b, _ in disabled}  # MoveIt's reason for a pair the spec declares
     disabled += [(a, b, "User") for a, b in pairs.get("declared", []) if (a, b) not in listed]
+    listed = {(a, b) for a, b, _ in disabled}  # in contact at home around a loop closure
+    disabled += [(a, b, "Default") for a, b in pairs.get("loop", []) if (a, b) not in listed]
     for a, b, reason in sorted(disabled):
         sub(root, "disable_collisions", link1=a, link2=b, reason=reason)
     return {layout.srdf(robot.name): to_bytes(root, HEADER.format(spec=robot.spec_file))}

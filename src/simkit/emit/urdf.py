@@ -9,7 +9,7 @@ import numpy as np
 from simkit.emit import ros2_control
 from simkit.kitio import layout
 from simkit.kitio.fmt import num, vec
-from simkit.kitio.xmlwriter import sub, to_bytes
+from simkit.kitio.xmlwriter import comment_text, sub, to_bytes
 from simkit.model.kinematics import rpy_matrix
 from simkit.model.robot import Joint, Link, Robot, Shape
 
@@ -137,11 +137,28 @@ def emit(robot: Robot) -> dict[str, bytes]:
         sub(joint, "child", link=frame.name)
         _origin(joint, frame.xyz, frame.rpy)
         _massless(sub(root, "link", name=frame.name))
+    root.extend(loop_comments(robot, "URDF"))
     root.extend(ros2_control.urdf_elements(robot))  # spec `ros2_control:` only; else nothing
     for i in range(len(robot.urdf_blocks)):  # placeholders for the carried blocks
         sub(root, BLOCK_TAG, index=str(i))
     text = to_bytes(root, HEADER.format(spec=robot.spec_file)).decode("utf-8")
     return {file: _with_blocks(text, robot.urdf_blocks).encode("utf-8")}
+
+
+def loop_comments(robot: Robot, noun: str) -> list[ET.Element]:
+    """One comment per loop closure (spec `loops`) in a format that holds only a tree
+    (URDF, SDFormat as Drake reads it): this file keeps the tree and leaves the loop open."""
+    return [
+        ET.Comment(
+            comment_text(
+                f" loop '{lp.name}' ({lp.type}): '{lp.link2}' held at xyz ({vec(lp.xyz)}) rpy "
+                f"({vec(lp.rpy)}) in '{lp.link1}''s frame; {noun} cannot carry a loop: this "
+                "file keeps the tree and leaves it open (the MJCF closes it with a weld, the "
+                "USD with a fixed joint excluded from the articulation) "
+            )
+        )
+        for lp in robot.loops
+    ]
 
 
 BLOCK_TAG = "simkit_urdf_block"

@@ -15,8 +15,9 @@ typed object every step receives), `read/` (what every reader shares) and `diagn
 
 The import picks the format once (formats.pick: the file's head read once), reads the file,
 then passes one draft through `steps(format)` in order: translate.to_spec, the names made
-legal, the format's edits, the refusals `--strict` asks for, the STEP budget, fixups.STEPS
-(rotors, base, home, stand, limits) and the format's last steps; then the format keeps its
+legal, the closed loops made spec `loops` (translate/loops.py), the format's edits, the
+refusals `--strict` asks for, the STEP budget, fixups.STEPS (rotors, base, home, stand,
+limits), the loops' poses at the final home and the format's last steps; then the format keeps its
 source (`keep`) and `write.finish` writes and validates the spec once and moves the files
 into place whole (write/output.py). The staging folder is removed on every way out.
 """
@@ -36,6 +37,7 @@ from simkit.importer.draft import DENSITY, Draft, Options, Unresolvable
 from simkit.importer.fixups import names, step_budget
 from simkit.importer.formats import Format
 from simkit.importer.read.options import ReadOptions
+from simkit.importer.translate import loops
 from simkit.importer.write.output import staging
 
 
@@ -49,8 +51,8 @@ def steps(fmt: Format) -> tuple[Callable[[Draft], None], ...]:
     """The import's steps for a file of format `fmt`, in order: each receives the draft
     and changes it."""
     return (
-        translate.to_spec, names.legal, *fmt.edits, _refused, step_budget.fit,
-        *fixups.STEPS, *fmt.after,
+        translate.to_spec, names.legal, loops.close, *fmt.edits, _refused, step_budget.fit,
+        *fixups.STEPS, loops.at_home, *fmt.after,
     )  # fmt: skip
 
 

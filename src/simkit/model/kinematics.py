@@ -185,16 +185,19 @@ def contracted_pairs(joined: Iterable[tuple[str, str]], solid: set[str]) -> set[
 
 
 def jointed_pairs(robot: Robot) -> list[tuple[str, str]]:
-    """Parent-child link pairs joined directly by a joint, in joint order: the pairs whose
-    contacts the MJCF and USD exclude (MoveIt's wider `adjacent_pairs` is a derive step)."""
+    """Parent-child link pairs joined directly by a joint, in joint order, then the pairs a
+    loop closure joins (spec `loops`, in order): the pairs whose contacts the MJCF and USD
+    exclude (MoveIt's wider `adjacent_pairs` is a derive step)."""
     links = {link.name for link in robot.links}
-    return [(j.parent, j.child) for j in robot.joints if j.parent in links]
+    pairs = [(j.parent, j.child) for j in robot.joints if j.parent in links]
+    return pairs + [(lp.link1, lp.link2) for lp in robot.loops if {lp.link1, lp.link2} <= links]
 
 
 def excluded_pairs(robot: Robot) -> list[tuple[str, str]]:
     """The link pairs the kit excludes from contact besides `jointed_pairs`: the derived
     `collision_pairs.always` pairs (in contact in every configuration), then `declared`
-    ones (the spec's `contact_excludes`, which the source excludes); each sorted. The MJCF
+    ones (the spec's `contact_excludes`, which the source excludes), then `loop` ones (in
+    contact at home around a loop closure, collision_pairs.loop_pairs); each sorted. The MJCF
     `<exclude>`s, the USD filtered pairs and the GPU scene take them."""
     block = robot.products.collision_pairs or {}
-    return [(a, b) for key in ("always", "declared") for a, b in block.get(key, [])]
+    return [(a, b) for key in ("always", "declared", "loop") for a, b in block.get(key, [])]

@@ -15,6 +15,7 @@ from simkit.model.robot import (
     Inertial,
     Joint,
     Link,
+    Loop,
     PlanningGroup,
     Robot,
     Shape,
@@ -228,6 +229,9 @@ def resolve(spec: RobotSpec, spec_bytes: bytes, spec_file: str) -> Robot:
         source_differences=tuple((d.what, d.reason, d.kit) for d in spec.source_differences),
         contact_excludes=tuple(sorted(tuple(sorted(p)) for p in spec.contact_excludes)),
         needs_active_balance=spec.needs_active_balance,
+        loops=tuple(
+            Loop(lp.name, lp.type, lp.link1, lp.link2, lp.xyz, lp.rpy_rad()) for lp in spec.loops
+        ),
     )
 
 

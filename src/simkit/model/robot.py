@@ -182,6 +182,19 @@ class Joint:
 
 
 @dataclass(frozen=True)
+class Loop:
+    """A kinematic loop closed by a constraint (spec `loops`): `link2`'s frame held at
+    `xyz` (m) / `rpy` (rad) in `link1`'s frame, its pose at home. `link1` may be the root."""
+
+    name: str
+    type: str  # "weld": position and orientation held
+    link1: str
+    link2: str
+    xyz: Vec3
+    rpy: Vec3
+
+
+@dataclass(frozen=True)
 class Frame:
     """A massless frame fixed to `parent` (a link or the root)."""
 
@@ -327,6 +340,8 @@ class Robot:
     contact_excludes: tuple[tuple[str, str], ...] = ()
     #: why the floating robot needs active balance (spec `needs_active_balance`), or None
     needs_active_balance: str | None = None
+    #: kinematic loops closed by a constraint (spec `loops`), in spec order
+    loops: tuple[Loop, ...] = ()
 
     @cached_property
     def by_name(self) -> tuple[dict[str, Link], dict[str, Joint]]:

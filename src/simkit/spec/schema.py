@@ -13,6 +13,7 @@ from typing import Annotated, Literal, Protocol, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from simkit.spec.loops import LoopSpec
 from simkit.spec.mjcf import MjcfSpec
 from simkit.spec.sim import FreefallSpec, InertiaDecisionSpec, Ros2ControlSpec
 
@@ -420,3 +421,5 @@ class RobotSpec(Strict):
     #: link pairs the source excludes from contact (an MJCF `<contact><exclude>`), each
     #: `[LINK, LINK]`: every format that can filter a pair gets them (MJCF, USD, SRDF)
     contact_excludes: tuple[tuple[str, str], ...] = ()
+    #: kinematic loops the tree cannot hold, each closed by a constraint (spec/loops.py)
+    loops: tuple[LoopSpec, ...] = ()

@@ -16,6 +16,7 @@ from pydantic import ValidationError
 
 from simkit.errors import SpecError
 from simkit.spec import bounds as spec_bounds
+from simkit.spec import loops as spec_loops
 from simkit.spec import mjcf as spec_mjcf
 from simkit.spec import names as spec_names
 from simkit.spec import sim as spec_sim
@@ -204,6 +205,7 @@ def _cross_reference(spec: RobotSpec) -> Iterator[Problem]:
             yield (key,), f"unknown link or frame '{value}'"
     yield from _planning_groups(spec)
     yield from _contact_excludes(spec)
+    yield from spec_loops.problems(spec)
     for k, field in enumerate(spec.published.estimated):
         if field not in ESTIMABLE_ROBOT:
             yield ("published", "estimated", k), f"'{field}' is not a published figure"
@@ -337,8 +339,10 @@ def validate(doc: SourceDoc) -> RobotSpec:
 
 
 def _pose_limits(spec: RobotSpec) -> Iterator[Problem]:
-    """Every named pose lies within the joint limits. Pose values follow the model's joint
-    order (depth-first, `resolve.py`), as `Robot.pose` reads them."""
+    """Every named pose lies within the joint limits and keeps each loop closed
+    (spec/loops.py). Pose values follow the model's joint order (depth-first,
+    `resolve.py`), as `Robot.pose` reads them."""
+    yield from spec_loops.pose_problems(spec, depth_first(spec.joints, spec.root))
     joints = [j for j in depth_first(spec.joints, spec.root) if j.movable]
     for key, scale in (("poses", 1.0), ("poses_deg", math.pi / 180)):
         for pose, values in getattr(spec, key).items():

@@ -96,6 +96,8 @@ def joints_from_parser(parsed: dict) -> list[UsdJoint]:
     for type_name, kind in (*MOVABLE.items(), ("FixedJoint", "fixed")):
         paths, descs = parsed.get(getattr(UsdPhysics.ObjectType, type_name), ([], []))
         for path, d in zip(paths, descs, strict=True):
+            if d.excludeFromArticulation:
+                continue  # a loop closure, not a tree joint (loop_joints)
             limit = drive = None
             if kind != "fixed":
                 if d.limit.enabled:
@@ -138,6 +140,8 @@ def joints_from_schemas(stage) -> list[UsdJoint]:
         if kind is None:
             continue
         j = UsdPhysics.Joint(prim)
+        if j.GetExcludeFromArticulationAttr().Get():
+            continue  # a loop closure, not a tree joint (loop_joints)
         bodies = [j.GetBody0Rel().GetTargets(), j.GetBody1Rel().GetTargets()]
         limit = drive = None
         axis = np.zeros(3)
@@ -168,6 +172,28 @@ def joints_from_schemas(stage) -> list[UsdJoint]:
                 limit,
                 drive,
             )
+        )
+    return out
+
+
+def loop_joints(stage) -> dict[str, tuple[str, str, np.ndarray, np.ndarray]]:
+    """The joints excluded from the articulation (how USD carries a kinematic loop), by
+    prim name: (body0 path, body1 path, localPose0, localPose1), read attribute by
+    attribute."""
+    from pxr import UsdPhysics
+
+    out = {}
+    for prim in stage.Traverse():
+        if not prim.IsA(UsdPhysics.Joint):
+            continue
+        j = UsdPhysics.Joint(prim)
+        if not j.GetExcludeFromArticulationAttr().Get():
+            continue
+        bodies = [j.GetBody0Rel().GetTargets(), j.GetBody1Rel().GetTargets()]
+        out[prim.GetName()] = (
+            *(str(b[0]) if b else "" for b in bodies),
+            matrix(j.GetLocalPos0Attr().Get(), j.GetLocalRot0Attr().Get()),
+            matrix(j.GetLocalPos1Attr().Get(), j.GetLocalRot1Attr().Get()),
         )
     return out
 

@@ -33,6 +33,7 @@ import numpy as np
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
+from simkit.check.source import loops as source_loops
 from simkit.check.source.shared import Allowed, inertia_close
 from simkit.kitio.oneline import one_line
 
@@ -94,6 +95,7 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
     declared = (kit.doc.get("collision_pairs") or {}).get("declared", [])
     excludes = _excludes(pairs, declared)
     out += _findings("source.excludes", excludes, f"{source.nexclude} contact excludes agree")
+    out += source_loops.compare_mjcf(pairs, kit.doc)
     return out + source_usd.compare(kit, source_usd.source_of_mjcf(source), allowed)
 
 

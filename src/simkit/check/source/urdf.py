@@ -20,6 +20,7 @@ import numpy as np
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
+from simkit.check.source import loops as source_loops
 from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
 from simkit.kitio.oneline import one_line
 
@@ -140,7 +141,8 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
         return [*findings, require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
     allowed = Allowed.of(kit.doc)
     usd = source_usd.compare(kit, source_usd.source_of_urdf(source), allowed)
-    return findings + compare_robots(source, built, allowed) + usd
+    loops = source_loops.compare(source.joints, kit.doc, allowed)
+    return findings + compare_robots(source, built, allowed) + loops + usd
 
 
 def compare_robots(source, built, allowed: Allowed) -> list[Finding]:

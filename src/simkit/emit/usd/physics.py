@@ -34,7 +34,7 @@ from simkit.emit.usd.robot_schema import apply_robot_schema
 from simkit.kitio.fmt import rounded
 from simkit.model.inertia import principal_axes
 from simkit.model.kinematics import excluded_pairs, jointed_pairs, rpy_matrix
-from simkit.model.robot import Joint, Link, Robot
+from simkit.model.robot import Joint, Link, Loop, Robot
 
 
 def _mass(prim, link: Link) -> None:
@@ -194,5 +194,26 @@ def physics_text(robot: Robot) -> str:
         if joint.type == "floating":
             continue  # a free base body: UsdPhysics has no joint to the world for it
         joints.append(_joint(stage, root, robot, joint, None if joint is anchor else anchor))
+    for loop in robot.loops:
+        _loop_joint(stage, root, robot, loop)
     apply_robot_schema(stage, top, robot, joints)
     return export(layer)
+
+
+def _loop_joint(stage, root: str, robot: Robot, loop: Loop) -> None:
+    """A loop closure (spec `loops`) as UsdPhysics carries a loop: a FixedJoint excluded from
+    the articulation (`physics:excludeFromArticulation`), holding `link2` at the loop's
+    pose in `link1`'s frame (the root frame: `/NAME`, as a joint from the root)."""
+    from pxr import Gf, UsdPhysics
+
+    body0, body1 = (
+        root if n == robot.root else f"{root}/{prim_name(n)}" for n in (loop.link1, loop.link2)
+    )
+    schema = UsdPhysics.FixedJoint.Define(stage, f"{root}/joints/{prim_name(loop.name)}")
+    schema.CreateBody0Rel().SetTargets([body0])
+    schema.CreateBody1Rel().SetTargets([body1])
+    schema.CreateLocalPos0Attr(Gf.Vec3f(*r(loop.xyz)))
+    schema.CreateLocalRot0Attr(quatf(rpy_matrix(loop.rpy)))
+    schema.CreateLocalPos1Attr(Gf.Vec3f(0.0, 0.0, 0.0))
+    schema.CreateLocalRot1Attr(quatf(np.eye(3)))
+    schema.CreateExcludeFromArticulationAttr(True)

@@ -43,7 +43,9 @@ def covered_shapes(link) -> tuple:
 def adjacent(robot) -> set[tuple[str, str]]:
     """Links joined by a joint, or through links without geometry (the kit's exclusions)."""
     solid = {link.name for link in robot.links if collision_shapes(link)}
-    return contracted_pairs(((j.parent, j.child) for j in robot.joints), solid)
+    joined = [(j.parent, j.child) for j in robot.joints]
+    joined += [(lp.link1, lp.link2) for lp in robot.loops]  # a loop closure joins them too
+    return contracted_pairs(joined, solid)
 
 
 def model_xml(robot, base_dir: Path, also_excluded: tuple = (), shapes_of=collision_shapes) -> str:

@@ -112,14 +112,15 @@ def differences(
 
 
 def _loops(source: Source, report: Said, add) -> None:
-    """A joint whose child link already hangs from an earlier joint (a closed loop) is left
-    out of the kit (formats/urdf/repairs.py): listed as `joints.J` with its report line."""
+    """A joint whose child link already hangs from an earlier joint (a closed loop) is not
+    a tree joint of the kit, which closes the loop with a weld (importer/translate/loops.py):
+    listed as `joints.J` with its report line."""
     parented: set[str] = set()
     for joint in source.root.findall("joint"):
         child = joint.find("child")
         link = None if child is None else child.get("link")
         if link in parented:
-            said = _said(report, source, joint) or "a second parent joint: a closed loop"
+            said = _said(report, source, joint) or "a second parent joint: closed by a weld"
             add(f"joints.{joint.get('name')}", said)
         parented.add(link)
 

@@ -43,6 +43,9 @@ class Source:
     scratch: list[Path] = field(default_factory=list)
     #: the format's own word for the file, in report lines ("URDF", "MJCF")
     noun: str = "URDF"
+    #: joints taken out of the tree because their child already hangs from an earlier one
+    #: (a closed loop, importer/translate/loops.py): each becomes a spec `loops` weld
+    closures: list = field(default_factory=list)
 
     @property
     def a_noun(self) -> str:

@@ -24,6 +24,7 @@ import numpy as np
 
 from simkit.errors import SpecError
 from simkit.importer.formats.mjcf import listed as mjcf_listed
+from simkit.importer.formats.mjcf import welds
 from simkit.importer.formats.mjcf.reader import MjcfSource
 
 #: mjtJoint: free, ball, slide, hinge; mjtGeom
@@ -123,6 +124,9 @@ def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple
         _sites(robot, model, body, names, off[body])
     why = "added: a link between two joints of one MJCF body"
     listed += [(f"links.{name}", why) for name in added]
+    source.closures = welds.closures(model, bodies, names.links)  # loops.close lists them
+    carried = {joint.get("listed") for joint in source.closures}
+    listed = [(what, reason) for what, reason in listed if what not in carried]
     _lines(robot, source, root_body)
     return robot, bool(floating), listed
 

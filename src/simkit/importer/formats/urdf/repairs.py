@@ -12,15 +12,16 @@
   definitions of a name are refused by `convert.tree`.
 - **A link with two parent joints** (an end effector fixed both to the world and to the
   ankle): a closed loop, which a kit's tree cannot hold. The tree is built from the link's
-  first joint in document order; each later one is left out, one report line each, and
-  listed in `source_differences` (`joints.J`, formats/provenance.py). The kit carries no
-  loop constraint (its spec has no weld equality), so the loop is open in every kit file.
+  first joint in document order; each later one is closed by a weld (spec `loops`) and
+  listed in `source_differences` (`joints.J`, formats/provenance.py): the shared rule of
+  importer/translate/loops.py, which `second_parents` calls.
 """
 
 from __future__ import annotations
 
 from simkit.importer.diagnostics import Report
 from simkit.importer.read.source import Source
+from simkit.importer.translate import loops
 
 
 def mounting_frame(source: Source, report: Report) -> str | None:
@@ -84,25 +85,7 @@ def _same(a, b) -> bool:
 
 
 def second_parents(source: Source, report: Report) -> None:
-    """Drop each `<joint>` whose child link already has a parent joint earlier in the
-    document (a closed loop), one report line each; the first joint builds the tree."""
-    first: dict[str, object] = {}
-    for joint in source.root.findall("joint"):
-        child = joint.find("child")
-        link = None if child is None else child.get("link")
-        if link is None:
-            continue  # refused by tree(), naming the joint
-        if link not in first:
-            first[link] = joint
-            continue
-        report.dropped(source, joint, loop_reason(source, first[link], link))
-        source.root.remove(joint)
-
-
-def loop_reason(source: Source, first, link: str) -> str:
-    """The one line on a joint left out because `link` already hangs from `first`."""
-    return (
-        f"link '{link}' already has a parent joint '{first.get('name')}' (line "
-        f"{first.sourceline or '?'}): a closed loop; the kit keeps the tree from the first "
-        f"joint and leaves the loop open (it carries no loop constraint)"
-    )
+    """The shared closed-loop rule (importer/translate/loops.py `second_parents`): each
+    later parent joint of a link taken out of the tree and closed by a weld. Kept under
+    this name, which the formats' readers call."""
+    loops.second_parents(source, report)
