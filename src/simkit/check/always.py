@@ -23,12 +23,12 @@ PROBES = 10  # sampled configurations tested besides home (a kit without `always
 SLACK = 0.99
 
 
-def _geoms(model: mujoco.MjModel, body: str) -> list[int]:
+def body_geoms(model: mujoco.MjModel, body: str) -> list[int]:
     bid = model.body(body).id
     return [g for g in range(model.ngeom) if model.geom_bodyid[g] == bid and model.geom_contype[g]]
 
 
-def _depth(model, data, a: list[int], b: list[int], touch: float = 0.0) -> float:
+def pair_depth(model, data, a: list[int], b: list[int], touch: float = 0.0) -> float:
     """Deepest penetration (m, <= -touch when apart) between two geom sets."""
     fromto = np.zeros(6)
     return max(
@@ -66,7 +66,7 @@ def not_touching(kit: Kit, model: mujoco.MjModel) -> list[str]:
         configs.append((f"sample {k}", q))
     touch = rule["touch"] if rule else 0.0
     data = mujoco.MjData(model)
-    geoms = {p: (_geoms(model, p[0]), _geoms(model, p[1])) for p in map(tuple, pairs)}
+    geoms = {p: (body_geoms(model, p[0]), body_geoms(model, p[1])) for p in map(tuple, pairs)}
     misses: dict[tuple, list[str]] = {p: [] for p in geoms}
     for where, q in configs:
         data.qpos[:] = model.qpos0
@@ -74,7 +74,7 @@ def not_touching(kit: Kit, model: mujoco.MjModel) -> list[str]:
             data.qpos[model.jnt_qposadr[model.joint(name).id]] = value
         mujoco.mj_kinematics(model, data)
         for p, (a, b) in geoms.items():
-            if _depth(model, data, a, b, touch) <= -touch:
+            if pair_depth(model, data, a, b, touch) <= -touch:
                 misses[p].append(where)
     # at most this many configurations apart (none without the rule)
     allowed = len(configs) - math.ceil(SLACK * rule["fraction"] * len(configs)) if rule else 0

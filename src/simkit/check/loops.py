@@ -22,6 +22,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from simkit.check.always import body_geoms, pair_depth
 from simkit.check.connected import home_poses
 from simkit.check.findings import Finding, compare, require
 from simkit.check.kit import Kit
@@ -76,8 +77,6 @@ def _pairs(kit: Kit, mj, pairs: list, loops: list[dict]) -> Finding:
     """`loops.pairs`: each pair robot.json excludes around a loop (`collision_pairs.loop`)
     joins a welded link or its neighbour (by robot.json's joints or loops) to the other
     welded link or its neighbour, and touches at home in the MJCF (within `TOUCH`)."""
-    from simkit.check.always import _depth, _geoms
-
     near: dict[str, set[str]] = {}
     joined = [(j["parent"], j["child"]) for j in kit.joints + kit.doc.get("fixed_joints", [])]
     for a, b in joined + [(lp["link1"], lp["link2"]) for lp in loops]:
@@ -96,7 +95,7 @@ def _pairs(kit: Kit, mj, pairs: list, loops: list[dict]) -> Finding:
         )
         if not around:
             wrong.append(f"{a}-{b}: not around a loop")
-        elif _depth(mj, data, _geoms(mj, a), _geoms(mj, b), TOUCH) < -TOUCH:
+        elif pair_depth(mj, data, body_geoms(mj, a), body_geoms(mj, b), TOUCH) < -TOUCH:
             wrong.append(f"{a}-{b}: apart at home")
     return require(
         "loops.pairs",
