@@ -1,4 +1,4 @@
-"""`simkit import`: a URDF, xacro, MJCF or SDFormat file becomes a spec YAML plus its meshes (simkit/importer)."""
+"""`simkit import`: a URDF, xacro, MJCF or SDFormat file to a spec YAML and meshes (importer)."""
 
 from __future__ import annotations
 

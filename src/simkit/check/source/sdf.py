@@ -172,7 +172,12 @@ class Compare:
         return self.k.bodies.get(self.allowed.links.get(one_line(name), name))
 
     def kit_joint(self, name: str):
-        return self.k.joints.get(self.allowed.joints.get(one_line(name), name))
+        """The kit's joint of source joint `name`; Drake files a joint under its child's
+        model, so a joint of the top model to a nested link is also tried by its own name."""
+        found = self.k.joints.get(self.allowed.joints.get(one_line(name), name))
+        if found is None and "::" in name:
+            return self.kit_joint(name.rpartition("::")[2])
+        return found
 
     def listed(self, key: str) -> bool:
         return key in self.allowed.keys
@@ -246,13 +251,17 @@ class Compare:
                 out.append(f"link '{name}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
             if not inertia_close(i0, i1) and not self.listed(f"{key}.inertia"):
                 out.append(
-                    f"link '{name}': inertia {_v(np.diag(i0))} kg m^2 in the source, {_v(np.diag(i1))} in the kit"
+                    f"link '{name}': inertia {_v(np.diag(i0))} kg m^2 in the source, "
+                    f"{_v(np.diag(i1))} in the kit"
                 )
         return out
 
     def fk(self) -> list[str]:
-        mounted = any(j.parent_body().index() == self.s.plant.world_body().index()
-                      and j.type_name() != "quaternion_floating" for j in self.s.joints.values())  # fmt: skip
+        world = self.s.plant.world_body().index()
+        mounted = any(
+            j.parent_body().index() == world and j.type_name() != "quaternion_floating"
+            for j in self.s.joints.values()
+        )
         roots = [b for b in self.s.bodies.values() if self.s.inboard(b) is None]
         ref = None if mounted or not roots else roots[0]
         ref_kit = None if ref is None else self.kit_body(self._name(ref))
@@ -289,8 +298,9 @@ class Compare:
             kind = joint.type_name()
             if kind == "ball_rpy":
                 angles = rng.uniform(-np.pi, np.pi, 3)
-                rot = RotationMatrix.MakeXRotation(angles[0]).multiply(
-                    RotationMatrix.MakeYRotation(angles[1])).multiply(RotationMatrix.MakeZRotation(angles[2]))  # fmt: skip
+                rot = RotationMatrix.MakeXRotation(angles[0])
+                rot = rot.multiply(RotationMatrix.MakeYRotation(angles[1]))
+                rot = rot.multiply(RotationMatrix.MakeZRotation(angles[2]))
                 joint.set_angles(self.s.context, RollPitchYaw(rot).vector())
                 for suffix, angle in zip(("_x", "_y", ""), angles, strict=True):
                     other = self.kit_joint(name + suffix)

@@ -20,8 +20,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.errors import SpecError
-
 MODEL = "__model__"
 WORLD = "world"
 

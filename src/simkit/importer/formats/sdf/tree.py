@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.errors import SpecError
 from simkit.importer.formats.sdf.frames import (
     MODEL,
     WORLD,
@@ -124,7 +123,7 @@ def to_tree(source) -> tuple[object, list[str]]:
     for name, joint in model.joints.items():
         parent = model.link_of(joint.find("parent").get("scoped"), joint.find("parent"))
         child = model.link_of(joint.find("child").get("scoped"), joint.find("child"))
-        if child == WORLD or child == MODEL or parent == MODEL:
+        if child in (WORLD, MODEL) or parent == MODEL:
             raise source.fail(joint, "a joint must join two links (or a link to the world)")
         ends.append((name, parent, child, joint))
         kit_frame.setdefault(child, name)
