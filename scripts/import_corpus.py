@@ -161,8 +161,9 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
                                         timeout)  # fmt: skip
     if rc:
         row["import"] = "refused"
-        row["reason"] = stderr.strip().splitlines()[-1][:160] if stderr.strip() else f"rc {rc}"
-        row["reason"] = row["reason"].removeprefix("simkit: error: ").replace(str(root) + "/", "")
+        said = stderr.strip().splitlines()[-1] if stderr.strip() else f"rc {rc}"
+        said = said.removeprefix("simkit: error: ").replace(str(root) + "/", "")
+        row["reason"] = said[:160]  # the corpus's own path taken out first: the reason is kept
         bad = _refusal(urdf, stderr) if rc != 124 else "timed out"
         row["invariant"] = bad or "ok"
         return row

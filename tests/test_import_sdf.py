@@ -16,6 +16,7 @@ from lxml import etree
 from simkit.errors import SpecError
 from simkit.importer import formats
 from simkit.importer.diagnostics import Policy, Report
+from simkit.importer.translate import ball_joints
 
 pytest.importorskip("pydrake")
 from simkit.check.source import sdf as proof
@@ -29,8 +30,11 @@ def _read(path: Path):
 
 
 def _findings(path: Path, tmp_path: Path, tamper=None) -> list:
-    """The proof's findings: Drake's reading of the SDF against the reader's tree (as URDF)."""
-    tree = _read(path).root
+    """The proof's findings: Drake's reading of the SDF against the reader's tree (as URDF,
+    a ball joint as the three revolute ones the translation makes of it)."""
+    read = _read(path)
+    ball_joints.expand(read)
+    tree = read.root
     if tamper:
         tamper(tree)
     urdf = tmp_path / "tree.urdf"
@@ -64,6 +68,18 @@ def test_nested_and_merged_include_through_model_uri(tmp_path):
     path = FILES / "models" / "robot" / "model.sdf"
     names = {link.get("name") for link in _read(path).root.iter("link")}
     assert names == {"palm", "left::knuckle", "left::pad", "knuckle", "pad"}
+    found = _findings(path, tmp_path)
+    assert all(f.ok for f in found), found
+
+
+def test_world_model_pose_world_joint_ball_and_old_axis_frame(tmp_path):
+    """A world file: the one robot beside static scenery (dropped, one line), placed by its
+    model pose and mounted on the world by a revolute joint whose SDFormat 1.6 axis is in
+    the parent model frame; a ball joint: Drake agrees; the base is fixed."""
+    path = FILES / "world.sdf"
+    read = _read(path)
+    assert read.base is not None and read.base[0] is False
+    assert "swivel" in read.base[1]
     found = _findings(path, tmp_path)
     assert all(f.ok for f in found), found
 
@@ -102,6 +118,8 @@ def test_refusals_are_one_line(tmp_path):
         '<link name="a"><pose relative_to="f"/></link></model>'
     )
     assert "cycle" in _one_line(tmp_path, cycle)
+    free = '<model name="m"><link name="a"/><link name="b"/></model>'
+    assert "2 links hang from no joint" in _one_line(tmp_path, free)
 
 
 def test_extensions_are_dropped_one_line_each(tmp_path):

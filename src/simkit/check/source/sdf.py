@@ -117,16 +117,24 @@ class Plant:
                 parser.package_map().Add(folder.name, str(folder))
         top = parser.AddModels(str(path))
         self.plant.Finalize()
-        names = [self.plant.GetModelInstanceName(m) for m in top]
         self.context = self.plant.CreateDefaultContext()
+        joints = [self.plant.get_joint(_index("Joint", i)) for i in range(self.plant.num_joints())]
+        names = [self.plant.GetModelInstanceName(m) for m in top]
+        moving = [n for n in names if any(_moves(j) and self._top(j, [n]) for j in joints)]
+        names = moving or names  # a world: its robot, as the import takes it, not scenery
         self.bodies, self.joints = {}, {}
         for i in range(self.plant.num_bodies()):
             body = self.plant.get_body(_index("Body", i))
-            if body.index() != self.plant.world_body().index():
+            if body.index() != self.plant.world_body().index() and self._top(body, names):
                 self.bodies[self._scoped(body, names)] = body
-        for i in range(self.plant.num_joints()):
-            joint = self.plant.get_joint(_index("Joint", i))
-            self.joints[self._scoped(joint, names)] = joint
+        for joint in joints:
+            if self._top(joint, names):
+                self.joints[self._scoped(joint, names)] = joint
+
+    def _top(self, element, tops: list[str]) -> bool:
+        """Whether `element` lies in one of the models `tops` (or a model nested in one)."""
+        instance = self.plant.GetModelInstanceName(element.model_instance())
+        return any(instance == t or instance.startswith(t + "::") for t in tops)
 
     def _scoped(self, element, tops: list[str]) -> str:
         instance = self.plant.GetModelInstanceName(element.model_instance())
@@ -154,6 +162,10 @@ class Plant:
 
     def pose(self, body) -> np.ndarray:
         return self.plant.EvalBodyPoseInWorld(self.context, body).GetAsMatrix4()
+
+
+def _moves(joint) -> bool:
+    return joint.type_name() not in ("weld", "quaternion_floating")
 
 
 def _index(kind: str, i: int):

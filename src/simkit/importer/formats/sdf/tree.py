@@ -127,6 +127,13 @@ def to_tree(source) -> tuple[object, list[str]]:
             raise source.fail(joint, "a joint must join two links (or a link to the world)")
         ends.append((name, parent, child, joint))
         kit_frame.setdefault(child, name)
+    roots = [n for n in model.links if n not in kit_frame]
+    if len(roots) > 1:
+        raise source.fail(
+            model.links[roots[1]],
+            f"{len(roots)} links hang from no joint ({', '.join(roots[:4])}): bodies free in "
+            "the world, not one robot; import one per file",
+        )
     world = [n for n, p, _, _ in ends if p == WORLD]
     if world:
         link = etree.SubElement(robot, "link", name=WORLD)
