@@ -107,9 +107,11 @@ class Plant:
     names scoped below the file's top model (`a::b` in nested model `a`)."""
 
     def __init__(self, path: Path, models: Path) -> None:
+        from pydrake.common import set_log_level
         from pydrake.multibody.parsing import Parser
         from pydrake.multibody.plant import MultibodyPlant
 
+        set_log_level("err")  # Drake's parse warnings (unsupported friction) are not ours
         self.plant = MultibodyPlant(0.0)
         parser = Parser(self.plant)
         for folder in sorted(p for p in models.iterdir() if p.is_dir()):
