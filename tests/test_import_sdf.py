@@ -151,3 +151,11 @@ def test_seed_kit_sdf_round_trip(kit_factory, tmp_path):
     proved = [f for f in result.findings if f.check.startswith("source.")]
     assert {f.check for f in proved} >= {"source.joints", "source.links", "source.fk"}
     assert all(f.ok for f in proved), [f for f in proved if not f.ok]
+
+
+def test_proof_without_drake_fails_naming_the_install(monkeypatch, tmp_path):
+    """Without pydrake the SDFormat proof is one failing finding naming `pip install drake`
+    (the user asked for the proof; an unproved kit must not pass)."""
+    monkeypatch.setitem(__import__("sys").modules, "pydrake", None)  # import raises
+    found = proof.compare(None, FILES / "frames.sdf")
+    assert len(found) == 1 and not found[0].ok and "pip install drake" in found[0].detail

@@ -24,6 +24,7 @@ proofs fail likewise when their reader cannot run.
 from __future__ import annotations
 
 import hashlib
+import logging
 import tempfile
 from pathlib import Path, PurePosixPath
 
@@ -107,17 +108,21 @@ class Plant:
     names scoped below the file's top model (`a::b` in nested model `a`)."""
 
     def __init__(self, path: Path, models: Path) -> None:
-        from pydrake.common import set_log_level
         from pydrake.multibody.parsing import Parser
         from pydrake.multibody.plant import MultibodyPlant
 
-        set_log_level("err")  # Drake's parse warnings (unsupported friction) are not ours
         self.plant = MultibodyPlant(0.0)
         parser = Parser(self.plant)
         for folder in sorted(p for p in models.iterdir() if p.is_dir()):
             if not parser.package_map().Contains(folder.name):
                 parser.package_map().Add(folder.name, str(folder))
-        top = parser.AddModels(str(path))
+        logger = logging.getLogger("drake")  # its parse warnings (unsupported friction)
+        level = logger.level
+        logger.setLevel(logging.ERROR)
+        try:
+            top = parser.AddModels(str(path))
+        finally:
+            logger.setLevel(level)
         self.plant.Finalize()
         self.context = self.plant.CreateDefaultContext()
         joints = [self.plant.get_joint(_index("Joint", i)) for i in range(self.plant.num_joints())]
