@@ -51,6 +51,13 @@ def test_frames_relative_to_and_default_joint_frame(tmp_path):
     assert all(f.ok for f in found), found
 
 
+def test_scopes_frames_as_joint_ends_and_degrees(tmp_path):
+    """A nested model placed relative to a frame, a frame attached to a nested model, a joint
+    from a frame to a nested link, an axis expressed in a frame, a pose in degrees."""
+    found = _findings(FILES / "scopes.sdf", tmp_path)
+    assert all(f.ok for f in found), found
+
+
 def test_proof_fails_when_the_joint_frame_is_read_as_urdf_does(tmp_path):
     """The same file, the joint's pose read relative to the parent (URDF's rule): FK fails."""
 
