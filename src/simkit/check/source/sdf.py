@@ -79,7 +79,11 @@ def _lay_out(given: Path, recorded: dict, folder: Path) -> tuple[Path, list[str]
     digest = recorded.get("sha256")
     kept = given.parent / (given.name.removesuffix(".sdf") + ".assets")
     main, problems = folder / given.name, []
-    for rel, want in sorted((recorded.get("assets") or {}).items()):
+    assets = recorded.get("assets") or {}
+    key = next((rel for rel, want in assets.items() if want == digest), given.name)
+    up = given.resolve().parents
+    base = up[min(len(PurePosixPath(key).parts), len(up)) - 1]  # the model path
+    for rel, want in sorted(assets.items()):
         target = (folder / rel).resolve()
         if folder.resolve() not in target.parents or ".." in rel.split("/"):
             problems.append(f"asset '{rel}' lies outside the source's folder")
@@ -88,7 +92,7 @@ def _lay_out(given: Path, recorded: dict, folder: Path) -> tuple[Path, list[str]
             main = target
         found = [given] if want == digest else []
         found += [
-            given.parent / PurePosixPath(rel).name,
+            base / rel,
             kept / f"{want}{PurePosixPath(rel).suffix.lower()}",
         ]
         for candidate in found:

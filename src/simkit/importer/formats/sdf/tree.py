@@ -9,7 +9,9 @@ source check applies the same rule through Drake (the joint's frame on its child
 Joints: revolute (no finite limits: continuous), continuous, prismatic, fixed, ball ->
 `spherical` (three revolute joints, translate/ball_joints.py); a joint to `world` mounts the
 robot (a fixed base); a link's second parent joint (a closed loop) stays in the tree for the
-URDF repair to leave out (formats/urdf/repairs.py). Universal, revolute2, screw and gearbox
+URDF repair to leave out (formats/urdf/repairs.py). A `<frame>` is a kit frame: a massless
+leaf link on a fixed joint from the link it is attached to (the canonical link for the model
+frame, the world where a joint mounts the model). Universal, revolute2, screw and gearbox
 joints are one line each: a kit's joints turn about one axis each. Nested model names are
 scoped (`a::b`); fixups/names.py makes them legal spec names and records the renames.
 """
@@ -53,7 +55,12 @@ class Model:
         self.frames = Frames(source)
         self.links: dict[str, object] = {}
         self.joints: dict[str, object] = {}
+        #: the `<frame>`s the model names (not the merged includes' model frames)
+        self.named: dict[str, object] = {}
+        self.canonical = ""
         self._flatten(source.model, "")
+        given = source.model.get("canonical_link")
+        self.canonical = given or self.canonical
 
     def _flatten(self, model, scope: str) -> None:
         first_link = None
@@ -71,17 +78,21 @@ class Model:
             if child.tag == "link":
                 self.links[name] = child
                 first_link = first_link or name
+                self.canonical = self.canonical or ("" if scope else name)
                 self.frames.add(
                     name, child, scoped(scope, rel or MODEL), pose_of(self.source, pose)
                 )
             elif child.tag == "frame":
                 attached = scoped(scope, child.get("attached_to") or MODEL)
                 self.frames.attached[name] = attached
+                if not name.rpartition("::")[2].startswith("_merged__"):
+                    self.named[name] = child
                 self.frames.add(name, child, scoped(scope, rel) if rel else attached,
                                 pose_of(self.source, pose))  # fmt: skip
             elif child.tag == "joint":
                 self.joints[name] = child
                 kid = scoped(scope, (child.findtext("child") or "").strip())
+                self.frames.attached[name] = kid  # a joint's frame moves with its child
                 self.frames.add(name, child, scoped(scope, rel) if rel else kid,
                                 pose_of(self.source, pose))  # fmt: skip
                 for tag in ("parent", "child"):
@@ -142,10 +153,39 @@ def to_tree(source) -> tuple[object, list[str]]:
         _link(robot, model, name, element, kit_frame.get(name, name))
     for name, parent, child, joint in ends:
         _joint(robot, model, name, joint, parent, child, kit_frame)
+    _frames(robot, model, kit_frame, WORLD if world else model.canonical)
     for element in robot.iter():  # report lines: an element without one takes its parent's
         if not element.sourceline and element.getparent() is not None:
             element.sourceline = element.getparent().sourceline
     return robot, world
+
+
+def _frames(robot, model: Model, kit_frame: dict[str, str], on_model: str) -> None:
+    """Each `<frame>`: a kit frame, a massless leaf link on a fixed joint from the link it
+    is attached to (one attached to the model frame: the world where a joint mounts the
+    model on it, else the canonical link, which carries the model frame)."""
+    from lxml import etree
+
+    taken = set(model.links) | set(model.joints) | set(model.named)
+    for name, element in model.named.items():
+        link = model.link_of(name, element)
+        link = on_model if link == MODEL else link
+        joint = _free(f"{name}_joint", taken)
+        out = etree.SubElement(robot, "joint", name=joint, type="fixed")
+        out.sourceline = element.sourceline
+        parent = _in_model(model, kit_frame.get(link, link), element)
+        _origin(out, inverse(parent) @ model.frames.in_model(name, element))
+        etree.SubElement(out, "parent", link=link)
+        etree.SubElement(out, "child", link=name)
+        etree.SubElement(robot, "link", name=name).sourceline = element.sourceline
+
+
+def _free(name: str, taken: set[str]) -> str:
+    out, n = name, 1
+    while out in taken:
+        out, n = f"{name}_{n}", n + 1
+    taken.add(out)
+    return out
 
 
 def _in_model(model: Model, name: str, element) -> np.ndarray:
