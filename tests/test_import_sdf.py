@@ -47,7 +47,7 @@ def test_frames_relative_to_and_default_joint_frame(tmp_path):
     """relative_to chains through a <frame>, a joint pose relative to its child link, an
     axis expressed in the model frame and one in the joint frame: Drake agrees."""
     tree = _read(FILES / "frames.sdf").root
-    mount = tree.find("joint[child/@link='mount']")  # a <frame>: a kit frame on its link
+    mount = tree.xpath("joint[child/@link='mount']")[0]  # a <frame>: a kit frame on its link
     assert mount.get("type") == "fixed" and mount.find("parent").get("link") == "base"
     found = _findings(FILES / "frames.sdf", tmp_path)
     assert [f.check for f in found] == ["source.joints", "source.links", "source.fk"]
