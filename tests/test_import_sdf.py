@@ -169,3 +169,46 @@ def test_proof_without_drake_fails_naming_the_install(monkeypatch, tmp_path):
     monkeypatch.setitem(__import__("sys").modules, "pydrake", None)  # import raises
     found = proof.compare(None, FILES / "frames.sdf")
     assert len(found) == 1 and not found[0].ok and "pip install drake" in found[0].detail
+
+
+def test_closed_loop_keeps_the_first_parent_joint(tmp_path):
+    """A link with two parent joints: the tree keeps the first, the second is left out with
+    one report line (formats/urdf/repairs.py second_parents, as for a URDF)."""
+    path = tmp_path / "loop.sdf"
+    path.write_text(
+        '<?xml version="1.0"?>\n<sdf version="1.9"><model name="m">'
+        '<link name="a"/><link name="b"/><link name="c"/>'
+        '<joint name="ab" type="revolute"><parent>a</parent><child>b</child>'
+        "<axis><xyz>0 0 1</xyz></axis></joint>"
+        '<joint name="ac" type="revolute"><parent>a</parent><child>c</child>'
+        "<axis><xyz>0 0 1</xyz></axis></joint>"
+        '<joint name="bc" type="fixed"><parent>b</parent><child>c</child></joint>'
+        "</model></sdf>\n"
+    )
+    report = Report(Policy())
+    read = formats.load(path, report=report)
+    assert [j.get("name") for j in read.root.iter("joint")] == ["ab", "ac"]
+    assert any("closed loop" in line and "bc" in line for line in report.lines)
+
+
+def test_a_mesh_through_model_uri_is_imported(tmp_path):
+    """A mesh named `model://NAME/...` in a Gazebo model folder is read into the kit's spec."""
+    import trimesh
+
+    from simkit.importer import import_robot
+
+    folder = tmp_path / "robot"
+    (folder / "meshes").mkdir(parents=True)
+    trimesh.creation.box((0.1, 0.2, 0.3)).export(folder / "meshes" / "box.stl")
+    (folder / "model.config").write_text('<model><sdf version="1.9">r.sdf</sdf></model>')
+    mesh = "<geometry><mesh><uri>model://robot/meshes/box.stl</uri></mesh></geometry>"
+    (folder / "r.sdf").write_text(
+        '<?xml version="1.0"?>\n<sdf version="1.9"><model name="r">'
+        f'<link name="a"><visual name="v">{mesh}</visual></link><link name="b"/>'
+        '<joint name="j" type="revolute"><parent>a</parent><child>b</child>'
+        "<axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis></joint>"
+        "</model></sdf>\n"
+    )
+    done = import_robot(folder, tmp_path / "out")
+    assert done.meshes == 1 and done.spec_path.name == "r.yaml"
+    assert (tmp_path / "out" / "r.source.sdf").read_bytes() == (folder / "r.sdf").read_bytes()

@@ -38,7 +38,10 @@ def sniff(path: Path, head: bytes) -> bool:
 
 
 def title(head: bytes) -> str | None:
-    """The first `<model name="...">`: the name the model's authors gave it."""
+    """The first `<model name="...">`: the name the model's authors gave it (a world's
+    first model may be scenery: the file's name then)."""
+    if re.search(rb"<\s*world[\s>]", head):
+        return None
     found = re.search(rb"<\s*model\b[^>]*?\bname\s*=\s*([\"'])([^\"']*)\1", head)
     return found.group(2).decode("utf-8", "replace") if found else None
 
