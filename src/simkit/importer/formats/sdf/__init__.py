@@ -24,7 +24,7 @@ from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
 #: the kit's own words for the source, in report lines and the spec's header
-NOUN = "SDFormat"
+NOUN = "SDF"
 
 
 def locate(path: Path) -> Path | None:
