@@ -129,9 +129,9 @@ class Files:
             raise SpecError(str(path), None, "xml", f"over {MAX_ELEMENTS} elements")
         return root
 
-    def uri(self, text: str, here: Path, where) -> Path:
+    def uri(self, text: str, here: Path, where, must_exist: bool = True) -> Path:
         """The file or folder a URI names, written in file `here`; one line when it is
-        refused (outside the model's folder, a network URI) or not found."""
+        refused (outside the model's folder, a network URI) or, `must_exist`, not found."""
         file, line, element = where
         text = text.strip()
         scheme = text.split("://", 1)[0].lower() if "://" in text else ""
@@ -157,7 +157,7 @@ class Files:
         inside = _inside(path, [folder]) if folder else False
         if not (inside or _inside(path, self.allowed()) or self.packages.allowed(path)):
             raise SpecError(file, line, element, f"'{text}' lies outside the model's folder")
-        if not path.exists():
+        if must_exist and not path.exists():
             raise SpecError(file, line, element, f"'{text}': no such file")
         return path.resolve()
 

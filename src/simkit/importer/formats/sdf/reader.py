@@ -7,11 +7,13 @@ holds, `<include>`s expanded, mesh URIs resolved, and the extensions a kit drops
 - `<include>`: the included model becomes a nested `<model>` (names scoped `a::b`), or with
   `merge="true"` its elements join the including model, the included model frame becoming
   the frame `_merged__NAME__model__` (as the specification defines it).
-- Mesh `<uri>`s are replaced by the file they name (files.py confines them).
+- Mesh `<uri>`s are replaced by the file they name (files.py confines them); a missing one
+  is dropped by the translation with one line, as for a URDF (`--strict` refuses it).
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -85,9 +87,10 @@ def _load(source: SdfSource, files, path: Path, where, depth: int):
         parent = uri.getparent()
         if parent is not None and parent.tag == "mesh":
             at = (str(path), uri.sourceline, "mesh.uri")
-            found = files.uri(uri.text or "", path, at)
-            files.read(found, at)
-            uri.text = str(found)
+            found = files.uri(uri.text or "", path, at, must_exist=False)
+            if found.is_file():  # else the translation drops it, one line (a URDF's rule)
+                files.read(found, at)
+            uri.text = Path(os.path.relpath(found, files.main.parent)).as_posix()  # no abs path
     for include in list(root.iter("include")):
         _include(source, files, path, include, depth)
     return root
