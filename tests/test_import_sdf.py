@@ -61,6 +61,16 @@ def test_scopes_frames_as_joint_ends_and_degrees(tmp_path):
     assert all(f.ok for f in found), found
 
 
+def test_universal_joint_is_two_revolute_joints(tmp_path):
+    """A universal joint: `u_1` about <axis>, `u` about <axis2>, the child's frame turned as
+    Drake turns it; Drake agrees (FK at 100 configurations, masses)."""
+    read = _read(FILES / "universal.sdf")
+    kinds = {j.get("name"): j.get("type") for j in read.root.iter("joint")}
+    assert kinds == {"u_1": "revolute", "u": "revolute"}
+    found = _findings(FILES / "universal.sdf", tmp_path)
+    assert all(f.ok for f in found), found
+
+
 def test_proof_fails_when_the_joint_frame_is_read_as_urdf_does(tmp_path):
     """The same file, the joint's pose read relative to the parent (URDF's rule): FK fails."""
 
@@ -115,8 +125,8 @@ LINKS = '<link name="a"/><link name="b"/>'
 
 
 def test_refusals_are_one_line(tmp_path):
-    joint = '<joint name="u" type="universal"><parent>a</parent><child>b</child></joint>'
-    assert "universal joint" in _one_line(tmp_path, f'<model name="m">{LINKS}{joint}</model>')
+    joint = '<joint name="u" type="revolute2"><parent>a</parent><child>b</child></joint>'
+    assert "revolute2 joint" in _one_line(tmp_path, f'<model name="m">{LINKS}{joint}</model>')
     assert "1.4 to 1.11" in _one_line(tmp_path, '<model name="m"><link name="a"/></model>', "2.0")
     fixed = '<joint name="j" type="fixed"><parent>a</parent><child>b</child></joint>'
     robot = f'<model name="{{}}">{LINKS}{fixed}</model>'

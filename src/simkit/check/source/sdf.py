@@ -37,6 +37,9 @@ from simkit.kitio.oneline import one_line
 
 FK_TOL = 1e-6
 SEEDS = 100
+#: Drake joint types the kit carries as several revolute joints: their name suffixes
+#: (translate/ball_joints.py; importer/formats/sdf/universal.py)
+SPLIT = {"ball_rpy": ("_x", "_y", ""), "universal": ("_1", "")}
 
 
 def remake(path: Path, args: dict[str, str]) -> bytes:
@@ -224,11 +227,14 @@ class Compare:
             kind = joint.type_name()
             if kind == "quaternion_floating" or self.listed(f"joints.{name}"):
                 continue
-            if kind == "ball_rpy":
-                parts = [self.kit_joint(f"{name}{x}") for x in ("_x", "_y", "")]
+            if kind in SPLIT:
+                parts = [self.kit_joint(f"{name}{x}") for x in SPLIT[kind]]
                 if any(p is None or p.type_name() != "revolute" for p in parts):
-                    out.append(f"joint '{name}': a ball, not three revolute joints in the kit")
-                continue
+                    said = " and ".join(name + x for x in SPLIT[kind])
+                    out.append(
+                        f"joint '{name}': a {kind}, not the revolute joints {said} in the kit"
+                    )
+                continue  # Drake reads no limits of either (a universal's: Drake 1.51)
             other = self.kit_joint(name)
             if other is None:
                 if kind != "weld":  # a weld may be merged away (a fixed joint's link kept)
@@ -329,17 +335,26 @@ class Compare:
                     other = self.kit_joint(name + suffix)
                     if other is not None and other.num_positions() == 1:
                         other.set_angle(self.k.context, angle)
+            elif kind == "universal":
+                angles = [self._draw(joint, k, rng) for k in range(2)]
+                joint.set_angles(self.s.context, angles)
+                for suffix, angle in zip(SPLIT[kind], angles, strict=True):
+                    other = self.kit_joint(name + suffix)
+                    if other is not None and other.num_positions() == 1:
+                        other.set_angle(self.k.context, angle)
             elif kind in ("revolute", "prismatic"):
-                span = np.pi if kind == "revolute" else 0.1
-                low, high = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
-                value = rng.uniform(
-                    max(low, -span) if np.isinf(low) else low,
-                    min(high, span) if np.isinf(high) else high,
-                )
+                value = self._draw(joint, 0, rng)
                 _set(joint, self.s.context, value)
                 other = self.kit_joint(name)
                 if other is not None and other.num_positions() == 1:
                     _set(other, self.k.context, value)
+
+    @staticmethod
+    def _draw(joint, k: int, rng) -> float:
+        """A value of the joint's `k`th position in its range (else +-pi rad, +-0.1 m)."""
+        span = 0.1 if joint.type_name() == "prismatic" else np.pi
+        low, high = joint.position_lower_limits()[k], joint.position_upper_limits()[k]
+        return rng.uniform(low if np.isfinite(low) else -span, high if np.isfinite(high) else span)
 
 
 def _set(joint, context, value: float) -> None:

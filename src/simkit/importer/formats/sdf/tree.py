@@ -9,9 +9,10 @@ source check applies the same rule through Drake (the joint's frame on its child
 Joints: revolute (no finite limits: continuous), continuous, prismatic, fixed, ball ->
 `spherical` (three revolute joints, translate/ball_joints.py); a joint to `world` mounts the
 robot (a fixed base); a link's second parent joint (a closed loop) stays in the tree for the
-URDF repair to leave out (formats/urdf/repairs.py). A `<frame>` is a kit frame: a massless
+URDF repair to leave out (formats/urdf/repairs.py); a universal joint is two revolute joints
+(universal.py). A `<frame>` is a kit frame: a massless
 leaf link on a fixed joint from the link it is attached to (the canonical link for the model
-frame, the world where a joint mounts the model). Universal, revolute2, screw and gearbox
+frame, the world where a joint mounts the model). Revolute2, screw and gearbox
 joints are one line each: a kit's joints turn about one axis each. Nested model names are
 scoped (`a::b`); fixups/names.py makes them legal spec names and records the renames.
 """
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simkit.importer.formats.sdf import universal
 from simkit.importer.formats.sdf.frames import (
     MODEL,
     WORLD,
@@ -137,7 +139,8 @@ def to_tree(source) -> tuple[object, list[str]]:
         if child in (WORLD, MODEL) or parent == MODEL:
             raise source.fail(joint, "a joint must join two links (or a link to the world)")
         ends.append((name, parent, child, joint))
-        kit_frame.setdefault(child, name)
+        turned = joint.get("type") == "universal" and child not in kit_frame
+        kit_frame.setdefault(child, universal.turned(model, name, joint) if turned else name)
     roots = [n for n in model.links if n not in kit_frame]
     if len(roots) > 1:
         raise source.fail(
@@ -152,7 +155,10 @@ def to_tree(source) -> tuple[object, list[str]]:
     for name, element in model.links.items():
         _link(robot, model, name, element, kit_frame.get(name, name))
     for name, parent, child, joint in ends:
-        _joint(robot, model, name, joint, parent, child, kit_frame)
+        if joint.get("type") == "universal":
+            universal.emit(robot, model, (name, parent, child, joint), kit_frame)
+        else:
+            _joint(robot, model, name, joint, parent, child, kit_frame)
     _frames(robot, model, kit_frame, WORLD if world else model.canonical)
     for element in robot.iter():  # report lines: an element without one takes its parent's
         if not element.sourceline and element.getparent() is not None:
@@ -318,10 +324,18 @@ def _joint(robot, model: Model, name: str, joint, parent: str, child: str, kit_f
     etree.SubElement(out, "child", link=child)
     if kind in ("fixed", "ball"):
         return
-    axis = joint.find("axis")
+    etree.SubElement(out, "axis", xyz=fmt(axis_in_joint(model, joint, "axis", x_joint)))
+    _limits(out, src, joint.find("axis"), kind)
+
+
+def axis_in_joint(model: Model, joint, tag: str, x_joint: np.ndarray) -> np.ndarray:
+    """The unit axis of `<axis>` (or `<axis2>`) in the joint frame: its `<xyz>` expressed in
+    the joint frame unless `expressed_in` (or 1.4-1.6 `use_parent_model_frame`) says."""
+    src = model.source
+    axis = joint.find(tag)
     xyz = axis.find("xyz") if axis is not None else None
     if xyz is None:
-        raise src.fail(joint, f"a {kind} joint without <axis><xyz>")
+        raise src.fail(joint, f"a {joint.get('type')} joint without <{tag}><xyz>")
     vector = np.asarray(numbers(src, xyz, xyz.text, 3))
     if not np.linalg.norm(vector):
         raise src.fail(xyz, "a zero axis")
@@ -331,8 +345,7 @@ def _joint(robot, model: Model, name: str, joint, parent: str, child: str, kit_f
     if frame:
         rot = x_joint[:3, :3].T @ _in_model(model, scoped(xyz.get("scope", ""), frame), xyz)[:3, :3]
         vector = rot @ vector
-    etree.SubElement(out, "axis", xyz=fmt(vector / np.linalg.norm(vector)))
-    _limits(out, src, axis, kind)
+    return vector / np.linalg.norm(vector)
 
 
 def _limits(out, src, axis, kind: str) -> None:
