@@ -97,9 +97,11 @@ def test_world_model_pose_world_joint_ball_and_old_axis_frame(tmp_path):
     model pose and mounted on the world by a revolute joint whose SDFormat 1.6 axis is in
     the parent model frame; a ball joint: Drake agrees; the base is fixed."""
     path = FILES / "world.sdf"
-    read = _read(path)
+    report = Report(Policy())
+    read = formats.load(path, report=report)
     assert read.base is not None and read.base[0] is False
     assert "swivel" in read.base[1]
+    assert [line for line in report.lines if "scenery" in line and "ground" in line]
     found = _findings(path, tmp_path)
     assert all(f.ok for f in found), found
 
@@ -179,6 +181,17 @@ def test_proof_without_drake_fails_naming_the_install(monkeypatch, tmp_path):
     monkeypatch.setitem(__import__("sys").modules, "pydrake", None)  # import raises
     found = proof.compare(None, FILES / "frames.sdf")
     assert len(found) == 1 and not found[0].ok and "pip install drake" in found[0].detail
+
+
+def test_a_static_model_has_a_fixed_base(tmp_path):
+    path = tmp_path / "s.sdf"
+    path.write_text(
+        f'<?xml version="1.0"?>\n<sdf version="1.9"><model name="m"><static>true</static>{LINKS}'
+        '<joint name="j" type="revolute"><parent>a</parent><child>b</child>'
+        "<axis><xyz>0 0 1</xyz></axis></joint></model></sdf>\n"
+    )
+    read = _read(path)
+    assert read.base == (False, "fixed base: the model is <static>; --floating-base frees it")
 
 
 def test_closed_loop_keeps_the_first_parent_joint(tmp_path):
