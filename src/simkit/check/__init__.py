@@ -111,6 +111,7 @@ CHECK_LIBRARIES = (
     "manifold3d",
     "cadquery-ocp",
     "cadquery-ocp-novtk",
+    "drake",  # the SDFormat source proof (check/source/sdf.py)
 )
 
 
