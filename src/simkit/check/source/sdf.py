@@ -6,7 +6,8 @@ renames applied; a nested model's `a::b`):
 - joint types (a ball as three revolute joints NAME_x, NAME_y, NAME) and position limits;
 - every body's mass, CoM and inertia (<= 1e-6 relative), in the kit's link frame;
 - every body's pose at 100 seeded configurations (<= 1e-6 m, 1e-6 in rotation), relative to
-  the world where the source mounts the robot on it, else to the root body.
+  the world where the source mounts the robot on it, else to the root body;
+- masses and joint limits against the kit's composed USD too (kit_usd.py).
 
 Frames: the kit's link frame of a body is its inboard joint's frame (Drake's frame on the
 child), the body frame itself for the root, as the import defines it
@@ -32,6 +33,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.check.source import kit_usd as source_usd
 from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
 from simkit.kitio.oneline import one_line
 
@@ -69,7 +71,26 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
         built = Plant(kit.path(kit.urdf), kit.path(".").parent)
     except Exception as exc:
         return [require("source.read", False, f"Drake cannot read the kit's URDF: {_why(exc)}")]
-    return Compare(source, built, Allowed.of(kit.doc)).findings()
+    allowed = Allowed.of(kit.doc)
+    return Compare(source, built, allowed).findings() + source_usd.compare(
+        kit, usd_view(source), allowed
+    )
+
+
+def usd_view(source: Plant) -> tuple[dict[str, float], dict[str, tuple]]:
+    """The source as kit_usd.py compares it with the kit's USD: ({link: mass kg},
+    {joint: (revolute or prismatic, (lower, upper) deg or m, or None)})."""
+    masses = {name: float(body.default_mass()) for name, body in source.bodies.items()}
+    joints: dict[str, tuple] = {}
+    for name, joint in source.joints.items():
+        kind = joint.type_name()
+        if kind not in ("revolute", "prismatic"):
+            continue
+        low, high = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
+        scale = np.degrees(1.0) if kind == "revolute" else 1.0
+        finite = np.isfinite(low) and np.isfinite(high)
+        joints[name] = (kind, (low * scale, high * scale) if finite else None)
+    return masses, joints
 
 
 def _why(exc: Exception) -> str:
