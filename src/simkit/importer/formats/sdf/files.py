@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import os
+import re
 from pathlib import Path
 
 from simkit.errors import SpecError
@@ -120,7 +121,7 @@ class Files:
         """The root element of an SDF file (confined, capped, no entities or network)."""
         from lxml import etree
 
-        data = self.read(path, where, MAX_XML)
+        data = declared(self.read(path, where, MAX_XML))
         try:
             root = etree.fromstring(data, _parser())
         except etree.XMLSyntaxError as exc:
@@ -174,6 +175,17 @@ class Files:
             self.named.setdefault(name, self.key(sibling))
             return sibling.resolve()
         raise SpecError(*where, f"model://{name}: no such model beside {self.folder.name}")
+
+
+def declared(data: bytes) -> bytes:
+    """`data` with each element prefix it uses undeclared (`<gz:...>`, `<drake:...>`: SDFormat
+    readers ignore namespaces, XML refuses them) declared on the `<sdf>` tag, in its line."""
+    used = set(re.findall(rb"</?([A-Za-z_][\w.-]*):[A-Za-z_]", data))
+    missing = sorted(used - set(re.findall(rb"xmlns:([A-Za-z_][\w.-]*)\s*=", data)) - {b"xml"})
+    if not missing:
+        return data
+    names = b" ".join(b'xmlns:%s="urn:undeclared:%s"' % (p, p) for p in missing)
+    return re.sub(rb"<sdf\b", b"<sdf " + names, data, count=1)
 
 
 def scrubbed(element, line: int | None):

@@ -212,17 +212,31 @@ def _robot(source: SdfSource, root):
 
 
 def _extensions(source: SdfSource, model) -> None:
-    """Each element a kit carries nothing of: one report line (dropped) and listed."""
-    for element in list(model.iter()):
-        tag = element.tag if isinstance(element.tag, str) else ""
-        plain = tag.rpartition("}")[2]
-        foreign = tag.startswith("{") or ":" in tag
-        if plain not in EXTENSIONS and not foreign:
-            continue
-        parent = element.getparent()
-        if parent is None:
-            continue
-        what = EXTENSIONS.get(plain, f"an extension element <{plain}> of another simulator")
-        if source.report is not None:
-            source.report.dropped(source, element, f"{what}: not carried by the kit")
-        parent.remove(element)
+    """Each element a kit carries nothing of: one report line (dropped), removed; what lies
+    inside it is not walked (its line says it)."""
+    pending = [model]
+    while pending:
+        for element in list(pending.pop()):
+            tag = element.tag if isinstance(element.tag, str) else ""
+            plain = tag.rpartition("}")[2]
+            if plain not in EXTENSIONS and not tag.startswith("{"):
+                pending.append(element)
+                continue
+            named = f"{element.prefix}:{plain}" if element.prefix else plain
+            what = EXTENSIONS.get(plain, f"<{named}>, an extension of another simulator")
+            if source.report is not None:
+                shown = Named(named, element.sourceline, element.get("name"))
+                source.report.dropped(source, shown, f"{what}: not carried by the kit")
+            element.getparent().remove(element)
+
+
+@dataclass
+class Named:
+    """An element as a report line names it (`drake:joint`, not lxml's `{URI}joint`)."""
+
+    tag: str
+    sourceline: int | None
+    name: str | None
+
+    def get(self, key: str, default=None):
+        return self.name if key == "name" else default
