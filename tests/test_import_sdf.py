@@ -82,12 +82,27 @@ def test_proof_fails_when_the_joint_frame_is_read_as_urdf_does(tmp_path):
     assert any(f.check == "source.fk" and not f.ok for f in found)
 
 
+def test_proof_fails_when_a_kit_frame_is_misplaced(tmp_path):
+    """The kit frame of <frame name="mount"> moved 1 mm: the proof's FK names it."""
+
+    def moved(tree):
+        origin = tree.xpath("joint[child/@link='mount']/origin")[0]
+        x, y, z = (float(v) for v in origin.get("xyz").split())
+        origin.set("xyz", f"{x + 0.001} {y} {z}")
+
+    found = _findings(FILES / "frames.sdf", tmp_path, moved)
+    assert [f.detail for f in found if not f.ok and "'mount'" in f.detail], found
+
+
 def test_nested_and_merged_include_through_model_uri(tmp_path):
     """model://finger included twice: nested (`left::knuckle`) and merged (`knuckle`), a
     joint axis expressed in a nested link's frame: Drake agrees; the names are scoped."""
     path = FILES / "models" / "robot" / "model.sdf"
-    names = {link.get("name") for link in _read(path).root.iter("link")}
-    assert names == {"palm", "left::knuckle", "left::pad", "knuckle", "pad"}
+    tree = _read(path).root
+    names = {link.get("name") for link in tree.iter("link")}
+    assert names == {"palm", "left::knuckle", "left::pad", "knuckle", "pad", "left::tip", "tip"}
+    frames = {j.find("child").get("link"): j.find("parent").get("link") for j in tree.iter("joint")}
+    assert frames["tip"] == "knuckle" and frames["left::tip"] == "left::knuckle"  # model frame
     found = _findings(path, tmp_path)
     assert all(f.ok for f in found), found
 

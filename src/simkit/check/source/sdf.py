@@ -5,7 +5,8 @@ renames applied; a nested model's `a::b`):
 
 - joint types (a ball as three revolute joints NAME_x, NAME_y, NAME) and position limits;
 - every body's mass, CoM and inertia (<= 1e-6 relative), in the kit's link frame;
-- every body's pose at 100 seeded configurations (<= 1e-6 m, 1e-6 in rotation), relative to
+- every body's pose, and every `<frame>`'s the kit carries as a frame, at 100 seeded
+  configurations (<= 1e-6 m, 1e-6 in rotation), relative to
   the world where the source mounts the robot on it, else to the root body;
 - masses and joint limits against the kit's composed USD too (kit_usd.py).
 
@@ -165,6 +166,12 @@ class Plant:
         for joint in joints:
             if self._top(joint, names):
                 self.joints[self._scoped(joint, names)] = joint
+        #: the named frames that are no body's (an SDF `<frame>`; Drake's joint frames too)
+        self.frames = {}
+        for i in range(self.plant.num_frames()):
+            frame = self.plant.get_frame(_index("Frame", i))
+            if not frame.is_body_frame() and self._top(frame, names):
+                self.frames.setdefault(self._scoped(frame, names), frame)
 
     def _top(self, element, tops: list[str]) -> bool:
         """Whether `element` lies in one of the models `tops` (or a model nested in one)."""
@@ -197,6 +204,9 @@ class Plant:
 
     def pose(self, body) -> np.ndarray:
         return self.plant.EvalBodyPoseInWorld(self.context, body).GetAsMatrix4()
+
+    def frame_pose(self, frame) -> np.ndarray:
+        return frame.CalcPoseInWorld(self.context).GetAsMatrix4()
 
 
 def _moves(joint) -> bool:
@@ -319,14 +329,18 @@ class Compare:
             return [f"the root body '{ref.name()}' is missing from the kit"]
         pairs = [(n, b, self.kit_body(n)) for n, b in sorted(self.s.bodies.items())]
         pairs = [(n, b, k) for n, b, k in pairs if k is not None]
+        frames = [(n, f, self.kit_body(n)) for n, f in sorted(self.s.frames.items())]
+        frames = [(n, f, k) for n, f, k in frames if k is not None and n not in self.s.bodies]
         rng = np.random.default_rng(0)
         worst: dict[str, float] = {}
         for _ in range(SEEDS):
             self._configure(rng)
             xs0 = np.eye(4) if ref is None else self.s.pose(ref)
             xk0 = np.eye(4) if ref_kit is None else self.k.pose(ref_kit)
-            for name, body, other in pairs:
-                xs = np.linalg.inv(xs0) @ self.s.pose(body) @ self.s.kit_frame(body)
+            poses = [(n, self.s.pose(b) @ self.s.kit_frame(b), k) for n, b, k in pairs]
+            poses += [(n, self.s.frame_pose(f), k) for n, f, k in frames]  # kit frames
+            for name, pose, other in poses:
+                xs = np.linalg.inv(xs0) @ pose
                 xk = np.linalg.inv(xk0) @ self.k.pose(other)
                 err = float(np.max(np.abs(xs[:3] - xk[:3])))
                 if err > FK_TOL:

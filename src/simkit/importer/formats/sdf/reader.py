@@ -132,9 +132,18 @@ def _merge(parent, include, inner) -> None:
     name = f"_merged__{inner.get('name')}__model__"
     frame = etree.Element("frame", name=name)
     frame.sourceline = include.sourceline
+    canonical = inner.get("canonical_link") or next(
+        (c.get("name") for c in inner if c.tag == "link"), None
+    )
+    if canonical:  # the merged model frame moves with its canonical link
+        frame.set("attached_to", canonical)
     pose = inner.find("pose")
-    if pose is not None:
-        frame.append(pose)
+    if pose is None:
+        pose = etree.SubElement(frame, "pose")
+        pose.text = "0 0 0 0 0 0"
+    frame.append(pose)
+    if not pose.get("relative_to"):
+        pose.set("relative_to", "__model__")  # the including model's frame
     at = parent.index(include)
     parent.remove(include)
     parent.insert(at, frame)
