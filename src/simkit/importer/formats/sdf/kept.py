@@ -2,8 +2,9 @@
 (`NAME.source.sdf`), and every other file it read (includes, model.config, meshes) as
 `NAME.source.assets/SHA256.EXT`; the spec's `source.assets` records them all (path relative
 to the model path, the model folder's parent -> SHA-256; the model file is the one whose
-digest is `source.sha256`: its entry gives its place). The source check (check/source/sdf.py) lays them out again,
-each top folder a model (`model://NAME`), and reads them with Drake.
+digest is `source.sha256`: its entry gives its place). The source check
+(check/source/sdf.py) lays them out again, each top folder a model (`model://NAME`), and
+reads them with Drake.
 """
 
 from __future__ import annotations
