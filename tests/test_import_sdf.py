@@ -39,7 +39,13 @@ def _findings(path: Path, tmp_path: Path, tamper=None) -> list:
         tamper(tree)
     urdf = tmp_path / "tree.urdf"
     urdf.write_bytes(etree.tostring(tree))
-    source = proof.Plant(path, path.parent.parent)
+    root = path.parent.parent if (path.parent / "model.config").is_file() else path.parent
+    laid = tmp_path / "laid"  # as the proof lays the source out: model folders named by file
+    shutil.copytree(root, laid)
+    for copy in laid.rglob("*.sdf"):
+        proof.model_folders(copy, laid)
+    path = laid / path.relative_to(root)
+    source = proof.Plant(path, laid)
     return proof.Compare(source, proof.Plant(urdf, tmp_path), Allowed()).findings()
 
 

@@ -129,7 +129,41 @@ def _lay_out(given: Path, recorded: dict, folder: Path) -> tuple[Path, list[str]
             problems.append(f"source file '{rel}' is missing or not the one the import read")
     if not main.is_file():
         main.write_bytes(given.read_bytes())
+    for laid in folder.rglob("*.sdf"):
+        model_folders(laid, folder)
     return main, problems
+
+
+def model_folders(path: Path, folder: Path) -> None:
+    """`<uri>model://NAME</uri>` (a model folder, which Gazebo reads through its
+    model.config and Drake does not) made `model://NAME/FILE`, the newest SDF the laid-out
+    model.config names; in the laid-out copy only."""
+    import re
+
+    def named(match: re.Match) -> bytes:
+        file = _config_file(folder / match.group(1).decode() / "model.config")
+        return b"<uri>model://%s/%s</uri>" % (match.group(1), file.encode()) if file else match[0]
+
+    data = path.read_bytes()
+    done = re.sub(rb"<uri>\s*model://([A-Za-z0-9_.-]+)/?\s*</uri>", named, data)
+    if done != data:
+        path.write_bytes(done)
+
+
+def _config_file(config: Path) -> str | None:
+    """The SDF file a model.config names (its newest `<sdf version>`), or None."""
+    from lxml import etree
+
+    try:
+        root = etree.fromstring(config.read_bytes(), etree.XMLParser(resolve_entities=False))
+    except (OSError, etree.XMLSyntaxError):
+        return None
+    named = []
+    for element in root.iter("sdf"):
+        version = tuple(int(v) for v in (element.get("version") or "0").split(".") if v.isdigit())
+        if (element.text or "").strip():
+            named.append((version, element.text.strip()))
+    return max(named)[1] if named else None
 
 
 class Plant:

@@ -103,6 +103,7 @@ def _include(source: SdfSource, files, path: Path, include, depth: int) -> None:
     if target.is_dir():
         if not (target / "model.config").is_file():
             raise SpecError(*where, f"'{include.findtext('uri')}' is a folder without model.config")
+        files.read(target / "model.config", where)  # kept: the proof resolves it again
         target = sdf_files.from_config(target, where)
     inner_root = _load(source, files, target, where, depth + 1)
     _version(source, inner_root)
