@@ -7,6 +7,7 @@ the reader gives is written as a URDF and read by Drake beside the SDF."""
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -183,7 +184,8 @@ def test_extensions_are_dropped_one_line_each(tmp_path):
 @pytest.mark.slow
 def test_seed_kit_sdf_round_trip(kit_factory, tmp_path):
     """A seed kit's own SDF imports to a kit whose URDF the source proof (Drake) finds
-    equal to the SDF's robot: the import's build runs that proof."""
+    equal to the SDF's robot (the build runs that proof), and equal to the seed kit's own
+    URDF: masses, CoMs, inertias, FK at 100 seeds, joint types and limits."""
     from simkit.importer import import_robot
     from simkit.pipeline import build
 
@@ -196,6 +198,13 @@ def test_seed_kit_sdf_round_trip(kit_factory, tmp_path):
     proved = [f for f in result.findings if f.check.startswith("source.")]
     assert {f.check for f in proved} >= {"source.joints", "source.links", "source.fk"}
     assert all(f.ok for f in proved), [f for f in proved if not f.ok]
+    back = result.kit_dir
+    allowed = Allowed.of(json.loads((back / "robot.json").read_text()))
+    original = proof.Plant(next((copy / "urdf").glob("*.urdf")), copy.parent)
+    found = proof.Compare(
+        original, proof.Plant(next((back / "urdf").glob("*.urdf")), back.parent), allowed
+    )
+    assert all(f.ok for f in found.findings()), found.findings()
 
 
 def test_proof_without_drake_fails_naming_the_install(monkeypatch, tmp_path):
