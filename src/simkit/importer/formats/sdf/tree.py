@@ -145,8 +145,9 @@ def to_tree(source) -> tuple[object, list[str]]:
     if len(roots) > 1:
         raise source.fail(
             model.links[roots[1]],
-            f"{len(roots)} links hang from no joint ({', '.join(roots[:4])}): bodies free in "
-            "the world, not one robot; import one per file",
+            f"{len(roots)} links hang from no joint ({', '.join(roots[:4])}): "
+            + ("static scenery" if source.static else "bodies free in the world")
+            + ", not one robot; import one per file",
         )
     world = [n for n, p, _, _ in ends if p == WORLD]
     if world:
