@@ -9,7 +9,8 @@ With `--pairs` the files are pairs: one robot as its URDF and as another format 
 an SDF or USD robot within 1.5x of its URDF). Each is imported and cold-built N times
 (default 3) with this checkout's src (or the first --src), the pair's runs interleaved so
 that load on the machine falls on both alike; per file the median wall and CPU seconds, per
-pair the ratio OTHER / REF of the medians.
+pair the ratio OTHER / REF of the medians (wall, and CPU: the figure load on a shared
+machine does not inflate).
 
 CPU seconds are user + system of the two processes and their children (getrusage), which
 other work on the machine does not inflate; the load average is taken when each row starts.
@@ -91,13 +92,17 @@ def pairs(src: Path, files: list[Path], repeats: int) -> None:
                         sys.exit(f"{path}: the import or the build failed")
                     runs.setdefault(path, []).append((wall, cpu))
     for ref, other in couples:
-        wall = {}
+        wall, cpu = {}, {}
         for path in (ref, other):
             wall[path] = statistics.median(w for w, _ in runs[path])
-            cpu = statistics.median(c for _, c in runs[path])
+            cpu[path] = statistics.median(c for _, c in runs[path])
             shown = " ".join(f"{w:.1f}" for w, _ in runs[path])
-            print(f"{path}: wall {shown} s, median {wall[path]:.1f} s (CPU {cpu:.1f} s)")
-        print(f"ratio {other.name} / {ref.name}: {wall[other] / wall[ref]:.2f}", flush=True)
+            print(f"{path}: wall {shown} s, median {wall[path]:.1f} s (CPU {cpu[path]:.1f} s)")
+        print(
+            f"ratio {other.name} / {ref.name}: {wall[other] / wall[ref]:.2f} wall, "
+            f"{cpu[other] / cpu[ref]:.2f} CPU",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":
