@@ -2,10 +2,11 @@
 
     python scripts/import_corpus.py CORPUS_DIR [--exclude GLOB ...] [--movable-only]
         [--only GLOB ...] [--title TITLE] [--timeout S] [--out DIR] [--md FILE] [--limit N]
-        [--ray] [--mjcf]
+        [--ray] [--mjcf | --sdf]
 
 Robot files are found by what they are: `*.urdf`, or with `--mjcf` the `*.xml` whose root
-element is `<mujoco>` (`--movable-only`: with a joint inside a body). Each (sorted by path,
+element is `<mujoco>` (`--movable-only`: with a joint inside a body), or with `--sdf` the
+`*.sdf` files (`--movable-only`: with a `<joint>`). Each (sorted by path,
 `--exclude` globs matched against the path relative to CORPUS_DIR): `simkit import URDF
 --out DIR` with no other flag, a cold build with an empty cache, then the same import again
 into the same folder. It checks issue 22's invariant: an import either refuses in one line
@@ -38,13 +39,19 @@ MOVABLE = {"revolute", "continuous", "prismatic"}
 
 
 def urdfs(
-    root: Path, exclude: list[str], movable_only: bool, only: list[str] = (), mjcf: bool = False
+    root: Path,
+    exclude: list[str],
+    movable_only: bool,
+    only: list[str] = (),
+    mjcf: bool = False,
+    sdf: bool = False,
 ) -> list[Path]:
     """The corpus's URDFs, sorted, less the excluded ones, only those matching `only` if
     given (and those without a movable joint when asked; a file that does not parse is kept:
     the import must refuse it)."""
     out = []
     found = (p for p in root.rglob("*") if _is_mjcf(p)) if mjcf else root.rglob("*.urdf")
+    found = root.rglob("*.sdf") if sdf else found
     for path in sorted(found):
         rel = path.relative_to(root).as_posix()
         if any(fnmatch.fnmatch(rel, glob) for glob in exclude):
@@ -67,6 +74,11 @@ def _is_mjcf(path: Path) -> bool:
 
 
 def _has_movable(path: Path) -> bool:
+    if path.suffix == ".sdf":  # an SDFormat file: any <joint> (its model moves on it)
+        try:
+            return any(True for _ in ET.parse(path).getroot().iter("joint"))
+        except ET.ParseError:
+            return True
     if path.suffix == ".xml":  # an MJCF: a joint inside a body (not a default class's)
         try:
             bodies = ET.parse(path).getroot().iter("body")
@@ -149,8 +161,9 @@ def one(urdf: Path, root: Path, work: Path, timeout: float) -> dict:
                                         timeout)  # fmt: skip
     if rc:
         row["import"] = "refused"
-        row["reason"] = stderr.strip().splitlines()[-1][:160] if stderr.strip() else f"rc {rc}"
-        row["reason"] = row["reason"].removeprefix("simkit: error: ").replace(str(root) + "/", "")
+        said = stderr.strip().splitlines()[-1] if stderr.strip() else f"rc {rc}"
+        said = said.removeprefix("simkit: error: ").replace(str(root) + "/", "")
+        row["reason"] = said[:160]  # the corpus's own path taken out first: the reason is kept
         bad = _refusal(urdf, stderr) if rc != 124 else "timed out"
         row["invariant"] = bad or "ok"
         return row
@@ -247,16 +260,18 @@ def main() -> None:
     parser.add_argument("--md", type=Path, default=REPO / "docs" / "import-corpus.md")
     parser.add_argument("--ray", action="store_true", help="one Ray task per URDF")
     parser.add_argument("--mjcf", action="store_true", help="MJCF files (<mujoco> root), not URDF")
+    parser.add_argument("--sdf", action="store_true", help="SDFormat files (*.sdf), not URDF")
     args = parser.parse_args()
     root = args.corpus.resolve()
     if not root.is_dir():
         sys.exit(f"{args.corpus}: not a folder")
-    found = urdfs(root, args.exclude, args.movable_only, args.only, args.mjcf)
+    found = urdfs(root, args.exclude, args.movable_only, args.only, args.mjcf, args.sdf)
     found = found[: args.limit] if args.limit else found
     title = args.title or root.name
     flags = [f"--exclude '{g}'" for g in args.exclude] + [f"--only '{g}'" for g in args.only]
     flags += ["--movable-only"] if args.movable_only else []
     flags += ["--mjcf"] if args.mjcf else []
+    flags += ["--sdf"] if args.sdf else []
     command = " ".join(["python scripts/import_corpus.py CORPUS", *flags])
 
     def done(rows: list[dict], r: dict) -> None:

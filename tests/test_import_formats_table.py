@@ -19,8 +19,8 @@ XACRO = (
 
 
 def test_the_two_tables_name_the_same_formats():
-    assert [f.name for f in formats.FORMATS] == ["xacro", "mjcf", "urdf"]
-    assert set(formats.BY_NAME) == set(source_check.COMPARE) == {"urdf", "xacro", "mjcf"}
+    assert [f.name for f in formats.FORMATS] == ["xacro", "mjcf", "sdf", "urdf"]
+    assert set(formats.BY_NAME) == set(source_check.COMPARE) == {"urdf", "xacro", "mjcf", "sdf"}
 
 
 def test_every_format_module_gives_sniff_read_and_keep():

@@ -1,4 +1,4 @@
-"""`simkit import`: a URDF, xacro or MJCF becomes a spec YAML plus its meshes (simkit/importer)."""
+"""`simkit import`: a URDF, xacro, MJCF or SDFormat file to a spec YAML and meshes (importer)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from simkit.errors import SimkitError
 
 
 @click.command(name="import")
-@click.argument("path", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("path", type=click.Path(path_type=Path))
 @click.option("--name", default=None, help="Spec name [a-z][a-z0-9_]*. [default: from PATH]")
 @click.option(
     "--package-dir",
@@ -72,8 +72,9 @@ def import_urdf(
     allow_read: tuple[Path, ...],
     trust_xacro: bool,
 ) -> None:
-    """Turn a URDF, a xacro or an MJCF (MuJoCo's XML, a <mujoco> file) at PATH into
-    OUT/NAME.yaml plus the meshes it needs."""
+    """Turn a URDF, a xacro, an MJCF (MuJoCo's XML, a <mujoco> file) or an SDFormat file
+    (.sdf, or a Gazebo model folder with model.config) at PATH into OUT/NAME.yaml plus the
+    meshes it needs."""
     from simkit.importer import import_robot
     from simkit.importer.read.options import ReadOptions, parse_xacro_arg
 

@@ -94,6 +94,7 @@ def import_robot(
     `reading`: what the reader may do (xacro args, environment, files outside the package;
     importer/read/options.py)."""
     picked = formats.pick(path)  # the file's head read once
+    path = picked.path or path  # a model folder: the model file it names
     name = name or robot_name(path, picked)
     if not re.fullmatch(r"[a-z][a-z0-9_]*", name):
         raise SpecError(str(path), None, "--name", f"'{name}' is not [a-z][a-z0-9_]*")

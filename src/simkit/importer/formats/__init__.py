@@ -9,7 +9,9 @@ Each format gives:
 - `keep(draft)`: the kept source written beside the spec and the spec's `source` and
   `source_differences` (formats/provenance.py);
 - `edits` and `after`: the format's own draft steps, run right after the translation
-  (before the shared fix-ups) and after them (importer.steps).
+  (before the shared fix-ups) and after them (importer.steps);
+- `locate(folder)` (optional): the model file a folder given as the robot holds (a Gazebo
+  model folder's SDF), else None.
 
 `pick` chooses the format once, from the first row whose `sniff` accepts the file; the URDF
 row accepts every file, so it comes last. A new format is one module here and one row in
@@ -26,7 +28,7 @@ from pathlib import Path
 
 from simkit.importer import read
 from simkit.importer.diagnostics import Report
-from simkit.importer.formats import mjcf, urdf, xacro
+from simkit.importer.formats import mjcf, sdf, urdf, xacro
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -43,12 +45,14 @@ class Format:
     noun: str = "URDF"
     edits: tuple[Callable[[object], None], ...] = ()
     after: tuple[Callable[[object], None], ...] = ()
+    #: the model file a folder given as the robot holds (None: the format reads no folders)
+    locate: Callable[[Path], Path | None] = lambda folder: None
 
 
 def _module_row(name: str, module) -> Format:
     return Format(
         name, module.sniff, module.title, module.read, module.keep, module.NOUN, module.EDITS,
-        module.AFTER,
+        module.AFTER, getattr(module, "locate", lambda folder: None),
     )  # fmt: skip
 
 
@@ -56,6 +60,7 @@ def _module_row(name: str, module) -> Format:
 FORMATS: tuple[Format, ...] = (
     _module_row("xacro", xacro),
     _module_row("mjcf", mjcf),
+    _module_row("sdf", sdf),
     _module_row("urdf", urdf),
 )
 BY_NAME = {f.name: f for f in FORMATS}
@@ -79,13 +84,18 @@ class Picked:
 
     format: Format
     title: str | None
+    #: the file to read: the path given, or the model file a model folder names
+    path: Path | None = None
 
 
 def pick(path: Path) -> Picked:
-    """The file's format, its head read once (the first row whose `sniff` accepts it)."""
+    """The file's format, its head read once (the first row whose `sniff` accepts it); a
+    folder is the model file a format's `locate` finds in it (a Gazebo model folder)."""
+    if path.is_dir():
+        path = next((found for f in FORMATS if (found := f.locate(path))), path)
     first = head(path)
     found = next(f for f in FORMATS if f.sniff(path, first))
-    return Picked(found, found.title(first))
+    return Picked(found, found.title(first), path)
 
 
 def load(

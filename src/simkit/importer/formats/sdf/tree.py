@@ -1,0 +1,380 @@
+"""A read SDFormat model (reader.py) to the URDF-shaped tree the shared translation takes.
+
+Frames follow the specification (frames.py). A URDF joint turns about its child link's
+origin; an SDF joint has its own frame (by default its child link's, moved by its `<pose>`).
+A link's kit frame is therefore its first parent joint's frame (the link frame itself for
+the root link), and its inertial, visuals and collisions are expressed in that frame; the
+source check applies the same rule through Drake (the joint's frame on its child).
+
+Joints: revolute (no finite limits: continuous), continuous, prismatic, fixed, ball ->
+`spherical` (three revolute joints, translate/ball_joints.py); a joint to `world` mounts the
+robot (a fixed base); a link's second parent joint (a closed loop) stays in the tree for the
+URDF repair to leave out (formats/urdf/repairs.py); a universal joint is two revolute joints
+(universal.py). A `<frame>` is a kit frame: a massless
+leaf link on a fixed joint from the link it is attached to (the canonical link for the model
+frame, the world where a joint mounts the model). Revolute2, screw and gearbox
+joints are one line each: a kit's joints turn about one axis each. Nested model names are
+scoped (`a::b`); fixups/names.py makes them legal spec names and records the renames.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simkit.importer.formats.sdf import universal
+from simkit.importer.formats.sdf.frames import (
+    MODEL,
+    WORLD,
+    Frames,
+    inverse,
+    numbers,
+    pose_of,
+    rpy_of,
+    scoped,
+)
+
+#: SDF joint type -> URDF type; the others are refused
+KINDS = {
+    "revolute": "revolute",
+    "continuous": "continuous",
+    "prismatic": "prismatic",
+    "fixed": "fixed",
+    "ball": "spherical",
+}
+#: |limit| at or above which an SDF limit means none (the specification's default is 1e16)
+NO_LIMIT = 1e15
+
+
+def fmt(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+class Model:
+    """The flattened model: links and joints by scoped name, their frame graph."""
+
+    def __init__(self, source) -> None:
+        self.source = source
+        self.frames = Frames(source)
+        self.links: dict[str, object] = {}
+        self.joints: dict[str, object] = {}
+        #: the `<frame>`s the model names (not the merged includes' model frames)
+        self.named: dict[str, object] = {}
+        self.canonical = ""
+        self._flatten(source.model, "")
+        given = source.model.get("canonical_link")
+        self.canonical = given or self.canonical
+
+    def _flatten(self, model, scope: str) -> None:
+        first_link = None
+        for child in model:
+            if not isinstance(child.tag, str) or child.tag not in (
+                "link",
+                "joint",
+                "frame",
+                "model",
+            ):
+                continue
+            name = scoped(scope, child.get("name") or "")
+            pose = child.find("pose")
+            rel = None if pose is None else pose.get("relative_to") or pose.get("frame") or None
+            if child.tag == "link":
+                self.links[name] = child
+                first_link = first_link or name
+                self.canonical = self.canonical or ("" if scope else name)
+                self.frames.add(
+                    name, child, scoped(scope, rel or MODEL), pose_of(self.source, pose)
+                )
+            elif child.tag == "frame":
+                attached = scoped(scope, child.get("attached_to") or MODEL)
+                self.frames.attached[name] = attached
+                if not name.rpartition("::")[2].startswith("_merged__"):
+                    self.named[name] = child
+                self.frames.add(name, child, scoped(scope, rel) if rel else attached,
+                                pose_of(self.source, pose))  # fmt: skip
+            elif child.tag == "joint":
+                self.joints[name] = child
+                kid = scoped(scope, (child.findtext("child") or "").strip())
+                self.frames.attached[name] = kid  # a joint's frame moves with its child
+                self.frames.add(name, child, scoped(scope, rel) if rel else kid,
+                                pose_of(self.source, pose))  # fmt: skip
+                for tag in ("parent", "child"):
+                    element = child.find(tag)
+                    if element is not None:
+                        element.set("scoped", scoped(scope, (element.text or "").strip()))
+                for xyz in child.iter("xyz"):
+                    xyz.set("scope", scope)
+            else:
+                self.frames.add(
+                    name, child, scoped(scope, rel or MODEL), pose_of(self.source, pose)
+                )
+                self._flatten(child, name)
+                canonical = child.get("canonical_link")
+                self.frames.attached[name] = scoped(name, canonical) if canonical else name + "::"
+        if scope:
+            self.frames.attached.setdefault(scope + "::", first_link or scope)
+
+    def link_of(self, name: str, element) -> str:
+        if name == WORLD:
+            return WORLD
+        found = self.frames.link_of(name, set(self.links), element)
+        while found.endswith("::"):
+            found = self.frames.link_of(self.frames.attached[found], set(self.links), element)
+        return found
+
+
+def to_tree(source) -> tuple[object, list[str]]:
+    """The `<robot>` tree of the model, and the joints mounting it on the world."""
+    from lxml import etree
+
+    model = Model(source)
+    if not model.links:
+        raise source.fail(source.model, "the model has no link")
+    robot = etree.Element("robot", name=source.model.get("name") or "robot")
+    robot.sourceline = source.model.sourceline
+    kit_frame: dict[str, str] = {}
+    ends: list[tuple[str, str, str, object]] = []
+    for name, joint in model.joints.items():
+        parent = model.link_of(joint.find("parent").get("scoped"), joint.find("parent"))
+        child = model.link_of(joint.find("child").get("scoped"), joint.find("child"))
+        if child in (WORLD, MODEL) or parent == MODEL:
+            raise source.fail(joint, "a joint must join two links (or a link to the world)")
+        ends.append((name, parent, child, joint))
+        turned = joint.get("type") == "universal" and child not in kit_frame
+        kit_frame.setdefault(child, universal.turned(model, name, joint) if turned else name)
+    roots = [n for n in model.links if n not in kit_frame]
+    if len(roots) > 1:
+        raise source.fail(
+            model.links[roots[1]],
+            f"{len(roots)} links hang from no joint ({', '.join(roots[:4])}): "
+            + ("static scenery" if source.static else "bodies free in the world")
+            + ", not one robot; import one per file",
+        )
+    world = [n for n, p, _, _ in ends if p == WORLD]
+    if world:
+        link = etree.SubElement(robot, "link", name=WORLD)
+        link.sourceline = model.joints[world[0]].sourceline
+    for name, element in model.links.items():
+        _link(robot, model, name, element, kit_frame.get(name, name))
+    for name, parent, child, joint in ends:
+        if joint.get("type") == "universal":
+            universal.emit(robot, model, (name, parent, child, joint), kit_frame)
+        else:
+            _joint(robot, model, name, joint, parent, child, kit_frame)
+    _frames(robot, model, kit_frame, WORLD if world else model.canonical)
+    for element in robot.iter():  # report lines: an element without one takes its parent's
+        if not element.sourceline and element.getparent() is not None:
+            element.sourceline = element.getparent().sourceline
+    return robot, world
+
+
+def _frames(robot, model: Model, kit_frame: dict[str, str], on_model: str) -> None:
+    """Each `<frame>`: a kit frame, a massless leaf link on a fixed joint from the link it
+    is attached to (one attached to the model frame: the world where a joint mounts the
+    model on it, else the canonical link, which carries the model frame)."""
+    from lxml import etree
+
+    taken = set(model.links) | set(model.joints) | set(model.named)
+    for name, element in model.named.items():
+        link = model.link_of(name, element)
+        link = on_model if link == MODEL else link
+        joint = _free(f"{name}_joint", taken)
+        out = etree.SubElement(robot, "joint", name=joint, type="fixed")
+        out.sourceline = element.sourceline
+        parent = _in_model(model, kit_frame.get(link, link), element)
+        _origin(out, inverse(parent) @ model.frames.in_model(name, element))
+        etree.SubElement(out, "parent", link=link)
+        etree.SubElement(out, "child", link=name)
+        etree.SubElement(robot, "link", name=name).sourceline = element.sourceline
+
+
+def _free(name: str, taken: set[str]) -> str:
+    out, n = name, 1
+    while out in taken:
+        out, n = f"{name}_{n}", n + 1
+    taken.add(out)
+    return out
+
+
+def _in_model(model: Model, name: str, element) -> np.ndarray:
+    """A frame's pose in the top model frame (the world: the model's pose inverted)."""
+    if name == WORLD:
+        return inverse(model.source.placed)
+    return model.frames.in_model(name, element)
+
+
+def _origin(parent, x: np.ndarray) -> None:
+    from lxml import etree
+
+    etree.SubElement(parent, "origin", xyz=fmt(x[:3, 3]), rpy=fmt(rpy_of(x[:3, :3])))
+
+
+def _placed(model: Model, element, link: str, kit: np.ndarray) -> np.ndarray:
+    """The pose of a link's child element (its `<pose>`, relative to the link unless it
+    says otherwise) in the link's kit frame (`kit`: that frame in the model)."""
+    pose = element.find("pose")
+    rel = None if pose is None else pose.get("relative_to")
+    base = (
+        model.frames.in_model(scoped(link.rpartition("::")[0], rel), pose)
+        if rel
+        else (model.frames.in_model(link))
+    )
+    return inverse(kit) @ base @ pose_of(model.source, pose)
+
+
+def _link(robot, model: Model, name: str, element, frame: str) -> None:
+    from lxml import etree
+
+    link = etree.SubElement(robot, "link", name=name)
+    link.sourceline = element.sourceline
+    kit = model.frames.in_model(frame, element)
+    inertial = element.find("inertial")
+    if inertial is not None and inertial.get("auto") in ("true", "1"):
+        raise model.source.fail(inertial, "automatic inertia (<inertial auto>): not read")
+    out = etree.SubElement(link, "inertial")
+    _origin(
+        out,
+        _placed(model, inertial, name, kit)
+        if inertial is not None
+        else inverse(kit) @ model.frames.in_model(name),
+    )
+    mass = 1.0 if inertial is None or inertial.find("mass") is None else numbers(
+        model.source, inertial.find("mass"), inertial.findtext("mass"), 1)[0]  # fmt: skip
+    etree.SubElement(out, "mass", value=fmt([mass]))
+    moments = inertial.find("inertia") if inertial is not None else None
+    terms = {}
+    for key, default in (
+        ("ixx", 1.0),
+        ("iyy", 1.0),
+        ("izz", 1.0),
+        ("ixy", 0.0),
+        ("ixz", 0.0),
+        ("iyz", 0.0),
+    ):
+        found = None if moments is None else moments.find(key)
+        terms[key] = fmt(
+            [default if found is None else numbers(model.source, found, found.text, 1)[0]]
+        )
+    etree.SubElement(out, "inertia", **terms)
+    for tag in ("visual", "collision"):
+        for k, shape in enumerate(element.findall(tag)):
+            _shape(link, model, name, shape, tag, k, kit)
+
+
+def _shape(link, model: Model, name: str, shape, tag: str, k: int, kit: np.ndarray) -> None:
+    """One visual or collision; shapes a URDF cannot hold are reported as dropped."""
+    from lxml import etree
+
+    geometry = shape.find("geometry")
+    kind = (
+        next((g for g in geometry if isinstance(g.tag, str)), None)
+        if geometry is not None
+        else None
+    )
+    if kind is None or kind.tag not in ("box", "sphere", "cylinder", "capsule", "mesh"):
+        if model.source.report is not None and kind is not None and kind.tag != "empty":
+            model.source.report.dropped(model.source, shape, f"<{kind.tag}> geometry: no URDF form")
+        return
+    out = etree.SubElement(link, tag)
+    if shape.get("name"):
+        out.set("name", shape.get("name"))
+    out.sourceline = shape.sourceline
+    _origin(out, _placed(model, shape, name, kit))
+    geo = etree.SubElement(out, "geometry")
+    src = model.source
+
+    def num(field: str, count: int = 1, default=None) -> list[float]:
+        element = kind.find(field)
+        if element is None:
+            if default is None:
+                raise src.fail(kind, f"<{kind.tag}> has no <{field}>")
+            return default
+        return numbers(src, element, element.text, count)
+
+    if kind.tag == "box":
+        etree.SubElement(geo, "box", size=fmt(num("size", 3)))
+    elif kind.tag == "sphere":
+        etree.SubElement(geo, "sphere", radius=fmt(num("radius")))
+    elif kind.tag in ("cylinder", "capsule"):
+        etree.SubElement(geo, kind.tag, radius=fmt(num("radius")), length=fmt(num("length")))
+    else:
+        mesh = etree.SubElement(geo, "mesh", filename=(kind.findtext("uri") or "").strip())
+        mesh.set("scale", fmt(num("scale", 3, [1.0, 1.0, 1.0])))
+    diffuse = shape.find("material/diffuse") if tag == "visual" else None
+    if diffuse is not None:
+        rgba = numbers(src, diffuse, diffuse.text)
+        rgba = (rgba + [1.0] * 4)[:4] if len(rgba) >= 3 else [0.7, 0.7, 0.7, 1.0]
+        material = etree.SubElement(out, "material", name=f"sdf_{name}_{tag}{k}")
+        etree.SubElement(material, "color", rgba=fmt(rgba))
+
+
+def _joint(robot, model: Model, name: str, joint, parent: str, child: str, kit_frame) -> None:
+    from lxml import etree
+
+    src = model.source
+    kind = (joint.get("type") or "").strip()
+    if kind not in KINDS:
+        raise src.fail(
+            joint, f"a {kind or 'typeless'} joint: a kit's joints turn about one axis each"
+        )
+    out = etree.SubElement(robot, "joint", name=name, type=KINDS[kind])
+    out.sourceline = joint.sourceline
+    x_joint = model.frames.in_model(name, joint)
+    parent_frame = kit_frame.get(parent, parent)
+    _origin(out, inverse(_in_model(model, parent_frame, joint)) @ x_joint)
+    etree.SubElement(out, "parent", link=parent)
+    etree.SubElement(out, "child", link=child)
+    if kind in ("fixed", "ball"):
+        return
+    etree.SubElement(out, "axis", xyz=fmt(axis_in_joint(model, joint, "axis", x_joint)))
+    _limits(out, src, joint.find("axis"), kind)
+
+
+def axis_in_joint(model: Model, joint, tag: str, x_joint: np.ndarray) -> np.ndarray:
+    """The unit axis of `<axis>` (or `<axis2>`) in the joint frame: its `<xyz>` expressed in
+    the joint frame unless `expressed_in` (or 1.4-1.6 `use_parent_model_frame`) says."""
+    src = model.source
+    axis = joint.find(tag)
+    xyz = axis.find("xyz") if axis is not None else None
+    if xyz is None:
+        raise src.fail(joint, f"a {joint.get('type')} joint without <{tag}><xyz>")
+    vector = np.asarray(numbers(src, xyz, xyz.text, 3))
+    if not np.linalg.norm(vector):
+        raise src.fail(xyz, "a zero axis")
+    frame = xyz.get("expressed_in")
+    if not frame and (axis.findtext("use_parent_model_frame") or "").strip() in ("true", "1"):
+        frame = MODEL
+    if frame:
+        rot = x_joint[:3, :3].T @ _in_model(model, scoped(xyz.get("scope", ""), frame), xyz)[:3, :3]
+        vector = rot @ vector
+    return vector / np.linalg.norm(vector)
+
+
+def _limits(out, src, axis, kind: str) -> None:
+    from lxml import etree
+
+    limit = axis.find("limit")
+
+    def value(tag: str) -> float | None:
+        found = None if limit is None else limit.find(tag)
+        return None if found is None else numbers(src, found, found.text, 1)[0]
+
+    lower, upper, effort, velocity = (value(t) for t in ("lower", "upper", "effort", "velocity"))
+    bounded = lower is not None and upper is not None and max(abs(lower), abs(upper)) < NO_LIMIT
+    if kind == "revolute" and not bounded:
+        out.set("type", "continuous")
+    attrs = {"lower": fmt([lower]), "upper": fmt([upper])} if bounded else {}
+    if effort is not None and effort > 0:
+        attrs["effort"] = fmt([effort])
+    if velocity is not None and velocity > 0:
+        attrs["velocity"] = fmt([velocity])
+    if attrs:
+        etree.SubElement(out, "limit", **attrs)
+    damping = axis.findtext("dynamics/damping")
+    friction = axis.findtext("dynamics/friction")
+    if damping or friction:
+        etree.SubElement(
+            out,
+            "dynamics",
+            damping=fmt([float(damping or 0)]),
+            friction=fmt([float(friction or 0)]),
+        )

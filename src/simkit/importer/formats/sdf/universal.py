@@ -1,0 +1,69 @@
+"""An SDF universal joint as two revolute joints (a kit's joints turn about one axis each).
+
+SDFormat's universal joint turns its child about `<axis>` (fixed in the parent), then about
+`<axis2>` (carried by the first turn), the two axes perpendicular, through the joint frame's
+origin. Drake reads it so too: its joint frames are the SDF joint frame turned so that x is
+`<axis>` and y is `<axis2>`, and it turns Rx(q1) Ry(q2). The kit takes that frame (`turned`)
+as the child link's frame, and the chain: `NAME_1` about x (the `<axis>` limits) into a
+massless link `NAME_link`, then `NAME` about y (the `<axis2>` limits) into the child; both
+added elements are listed in the spec's source differences.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simkit.importer.formats.sdf.frames import transform
+
+#: |cos| between the two axes above which they are not perpendicular
+PERPENDICULAR = 1e-6
+
+
+def axes(model, name: str, joint) -> tuple[np.ndarray, np.ndarray]:
+    """The two unit axes in the joint frame; one line when they are not perpendicular."""
+    from simkit.importer.formats.sdf.tree import axis_in_joint
+
+    x_joint = model.frames.in_model(name, joint)
+    first, second = (axis_in_joint(model, joint, tag, x_joint) for tag in ("axis", "axis2"))
+    if abs(float(first @ second)) > PERPENDICULAR:
+        raise model.source.fail(joint, "a universal joint whose two axes are not perpendicular")
+    return first, second
+
+
+def turned(model, name: str, joint) -> str:
+    """The name of the frame the child link takes: the joint frame turned so that x is
+    `<axis>` and y `<axis2>` (added to the frame graph)."""
+    first, second = axes(model, name, joint)
+    frame = f"{name}#universal"  # '#' is no SDF name: no clash
+    rot = np.column_stack([first, second, np.cross(first, second)])
+    model.frames.add(frame, joint, name, transform(rot, np.zeros(3)))
+    return frame
+
+
+def emit(robot, model, ends: tuple, kit_frame: dict[str, str]) -> None:
+    """The two revolute joints and the link between them, into `robot`."""
+    from lxml import etree
+
+    from simkit.importer.formats.sdf.tree import _in_model, _limits, _origin, inverse
+
+    name, parent, child, joint = ends
+    frame = kit_frame.get(child)
+    if frame != f"{name}#universal":  # a second parent (a loop): left out by the repair
+        frame = turned(model, name, joint)
+    mid = f"{name}_link"
+    parts = ((f"{name}_1", parent, mid, "1 0 0", "axis"), (name, mid, child, "0 1 0", "axis2"))
+    for k, (joint_name, up, down, xyz, tag) in enumerate(parts):
+        out = etree.SubElement(robot, "joint", name=joint_name, type="revolute")
+        out.sourceline = joint.sourceline
+        if k == 0:
+            parent_pose = _in_model(model, kit_frame.get(up, up), joint)
+            _origin(out, inverse(parent_pose) @ model.frames.in_model(frame, joint))
+        else:
+            _origin(out, np.eye(4))
+        etree.SubElement(out, "parent", link=up)
+        etree.SubElement(out, "child", link=down)
+        etree.SubElement(out, "axis", xyz=xyz)
+        _limits(out, model.source, joint.find(tag), "revolute")
+    etree.SubElement(robot, "link", name=mid).sourceline = joint.sourceline
+    why = "added: the link between a universal joint's two axes"
+    model.source.listed += [(f"links.{mid}", why), (f"joints.{name}_1", why)]
