@@ -33,6 +33,7 @@ from simkit.emit.usd.physx import physx_text
 from simkit.emit.usd.thumbnail import thumbnail_png
 from simkit.errors import SimkitError
 from simkit.kitio import layout
+from simkit.kitio.kitread import MAX_ENTRY
 from simkit.model.inertia import principal_axes
 from simkit.model.robot import Robot
 
@@ -55,6 +56,11 @@ __all__ = [
 FORMATS = ("usda", "usdc")
 #: the meshes, in text (`.usd` reads both encodings), or a crate with `--usd-format usdc`
 GEOMETRIES = "geometries.usd"
+#: bytes: a geometry text longer than this is written as a crate (about a third of the text),
+#: so a robot of many dense meshes stays under the kit's 64 MiB per-file cap
+#: (kitio/kitread.py MAX_ENTRY) instead of failing its build; half the cap, so the choice
+#: does not flip between two nearly equal builds near the cap
+TEXT_GEOMETRY_MAX = MAX_ENTRY // 2
 
 
 def layers(robot: Robot) -> dict[str, str]:
@@ -97,7 +103,7 @@ def emit(robot: Robot, binary: bool = False) -> dict[str, bytes]:
         files[path] = _usdc_bytes(text) if binary else text.encode()
         files[layout.usd_thumbnail(path)] = thumbnail
     for name, text in layers(robot).items():
-        crate = binary and name == GEOMETRIES
+        crate = name == GEOMETRIES and (binary or len(text) > TEXT_GEOMETRY_MAX)
         files[layout.usd_payload(robot.name, name)] = _usdc_bytes(text) if crate else text.encode()
     return dict(sorted(files.items()))
 
