@@ -1,0 +1,260 @@
+"""A USD articulation (stage.py) to the URDF-shaped tree the shared translation takes.
+
+Frames: a UsdPhysics joint joins body0's frame `localPos0/localRot0` to body1's
+`localPos1/localRot1`, and turns about its `axis` (X, Y or Z) of that joint frame. A URDF
+joint turns about its child link's origin, so a link's frame is its body's frame moved by the
+joint frame on it (`localPose1` of the joint it hangs from; the root's own body frame, or
+its world joint's `localPose1`). A joint written child-first (its body0 further from the root)
+is turned round: the frames swap and its axis flips, its limits stay. The source check
+(check/source/usd.py) applies the same rule to usd-core's own physics parser.
+
+Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prismatic (m),
+Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce` is the
+joint's effort, PhysX's `maxJointVelocity` (deg/s) its velocity. A joint with no body0 (or a
+body0 that is no rigid body) joins the robot to the world: on the root body a fixed one bolts
+the base (a `world` link), another moves it. Other joint types, and a drive's stiffness and
+damping (the kit sizes its own servos), are listed. A joint with `excludeFromArticulation`
+or one closing a loop is emitted after the tree, so the URDF repair `second_parents` leaves
+it out (listed as dropped).
+
+Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
+frame; where the mass is not authored, the collision shapes' solid at the MassAPI `density`
+(else 1000 kg/m^3, UsdPhysics' default), its CoM and inertia where those are not authored.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from simkit.importer.formats.usd import poses, shapes
+from simkit.importer.formats.usd.stage import Articulation, ends
+
+#: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
+UNBOUNDED = 1e30
+KINDS = {
+    "PhysicsRevoluteJoint": "revolute",
+    "PhysicsPrismaticJoint": "prismatic",
+    "PhysicsFixedJoint": "fixed",
+    "PhysicsSphericalJoint": "spherical",
+}
+WORLD = "world"
+
+
+@dataclass
+class Context:
+    """What the tree is built from: the articulation, the stage's units, an XformCache, the
+    scratch folder for meshes, the link names by body path, the listed differences."""
+
+    art: Articulation
+    units: poses.Units
+    cache: object
+    scratch: Path
+    names: dict[str, str] = field(default_factory=dict)
+    listed: list[tuple[str, str]] = field(default_factory=list)
+    dropped: list[tuple[object, str]] = field(default_factory=list)
+
+
+def unique_names(paths: list[str]) -> dict[str, str]:
+    """Prim path -> its name, made unique in path order (`NAME_1`, `NAME_2`...)."""
+    out, taken = {}, set()
+    for path in sorted(paths):
+        want = path.rsplit("/", 1)[-1] or "root"
+        name, n = want, 1
+        while name in taken:
+            name, n = f"{want}_{n}", n + 1
+        taken.add(name)
+        out[path] = name
+    return out
+
+
+def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
+    """The joint frame on body `end` (0 or 1) in that body's frame (m; the body's world
+    scale applied to `localPos`, as PhysX applies it)."""
+    pos = poses.get(joint, f"physics:localPos{end}")
+    rot = poses.get(joint, f"physics:localRot{end}")
+    body = ends(joint)[end]
+    scale = np.ones(3)
+    if body:
+        prim = ctx.art.stage.GetPrimAtPath(body)
+        if prim:
+            scale = poses.world(ctx.cache, prim, 1.0)[1]
+    at = np.zeros(3) if pos is None else np.asarray(pos, dtype=float) * scale
+    turn = np.eye(3) if rot is None else poses.quat_matrix(rot)
+    return poses.make(turn, at * ctx.units.meters)
+
+
+def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]:
+    """(`<robot>`, floating base, listed (what, reason), dropped (joint prim, why))."""
+    from lxml import etree
+    from pxr import UsdGeom
+
+    ctx = Context(art, poses.Units.of(art.stage), UsdGeom.XformCache(), scratch)
+    ctx.names = unique_names(art.bodies)
+    joint_names = unique_names([str(j.GetPath()) for j in art.joints])
+    robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
+    robot.sourceline = 0
+    root = str(art.root_prim.GetPath())
+    frames, order, loops, base = _walk(art, root, ctx)
+    floating = base is None
+    if base is not None:
+        etree.SubElement(robot, "link", name=WORLD).sourceline = 0
+        _joint(robot, base, joint_names, (WORLD, ctx.names[root]), _world_origin(base, ctx), ctx)
+    for body in art.bodies:
+        if body in frames:
+            _link(robot, body, frames[body], ctx)
+    for joint, parent, child, flip, origin in order:
+        ends_ = (ctx.names[parent], ctx.names[child])
+        _joint(robot, joint, joint_names, ends_, origin, ctx, flip)
+    for joint in loops:
+        a, b = ends(joint)
+        if a in ctx.names and b in ctx.names:
+            origin = poses.inv(frames.get(a, np.eye(4))) @ local_pose(joint, 0, ctx)
+            _joint(robot, joint, joint_names, (ctx.names[a], ctx.names[b]), origin, ctx)
+        else:
+            ctx.dropped.append((joint, "joins the robot to the world away from its root"))
+    for element in robot.iter():
+        element.sourceline = element.sourceline or 0
+    return robot, floating, ctx.listed, ctx.dropped
+
+
+def _walk(art: Articulation, root: str, ctx: Context):
+    """Breadth-first from the root body: each body's link frame (in its body frame), the
+    tree joints (joint, parent, child, flipped, origin), the loop joints, the base joint."""
+    from pxr import UsdPhysics
+
+    bodies = set(art.bodies)
+    frames: dict[str, np.ndarray] = {}
+    base, loops, order = None, [], []
+    tree_joints = []
+    for joint in art.joints:
+        a, b = ends(joint)
+        excluded = bool(UsdPhysics.Joint(joint).GetExcludeFromArticulationAttr().Get())
+        world = (a not in bodies) != (b not in bodies)
+        if world and base is None and root in (a, b) and not excluded:
+            base = joint
+        elif world or excluded:
+            loops.append(joint)
+        else:
+            tree_joints.append(joint)
+    frames[root] = np.eye(4)
+    if base is not None:
+        end = 1 if ends(base)[1] == root else 0
+        frames[root] = local_pose(base, end, ctx)
+    todo, used = [root], set()
+    while todo:
+        body = todo.pop(0)
+        for joint in tree_joints:
+            a, b = ends(joint)
+            if id(joint) in used or body not in (a, b):
+                continue
+            other, flip = (b, False) if a == body else (a, True)
+            if other in frames:
+                continue
+            used.add(id(joint))
+            near, far = (1, 0) if flip else (0, 1)
+            origin = poses.inv(frames[body]) @ local_pose(joint, near, ctx)
+            frames[other] = local_pose(joint, far, ctx)
+            order.append((joint, body, other, flip, origin))
+            todo.append(other)
+    loops += [j for j in tree_joints if id(j) not in used]
+    return frames, order, loops, base
+
+
+def _world_origin(joint, ctx: Context) -> np.ndarray:
+    """The world joint's frame in the world (m, Z up): its non-body end's world pose (the
+    world itself when unset) times that end's local pose."""
+    a, b = ends(joint)
+    end, other = (0, a) if b in ctx.names else (1, b)
+    at = np.eye(4)
+    prim = ctx.art.stage.GetPrimAtPath(other) if other else None
+    if prim:
+        at = poses.world(ctx.cache, prim, ctx.units.meters)[0]
+    up = poses.make(ctx.units.up, np.zeros(3))
+    return up @ at @ local_pose(joint, end, ctx)
+
+
+def _link(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
+    """`<link>` with its inertial (MassAPI, else the colliders' solid) and shapes."""
+    from lxml import etree
+
+    from simkit.importer.formats.usd import mass
+
+    prim = ctx.art.stage.GetPrimAtPath(body)
+    link = etree.SubElement(robot, "link", name=ctx.names[body])
+    approximations = shapes.shapes(link, prim, set(ctx.art.bodies), frame, ctx)
+    for how in sorted(set(approximations) - {"none"}):
+        why = f"a mesh collider's approximation '{how}': the kit makes its own convex pieces"
+        ctx.listed.append((f"links.{ctx.names[body]}.collision", why))
+    found = mass.of_body(prim, link, frame, ctx)
+    if found is None:
+        return
+    kg, com, rot, diagonal = found
+    inertial = etree.Element("inertial")
+    link.insert(0, inertial)
+    poses.origin(inertial, poses.make(rot, com))
+    etree.SubElement(inertial, "mass", value=poses.fmt([kg]))
+    ixx, iyy, izz = diagonal
+    etree.SubElement(
+        inertial, "inertia", ixx=poses.fmt([ixx]), iyy=poses.fmt([iyy]), izz=poses.fmt([izz]),
+        ixy="0", ixz="0", iyz="0",
+    )  # fmt: skip
+
+
+def _joint(robot, joint, names, link_names, origin, ctx: Context, flip: bool = False) -> None:
+    """`<joint>` of a UsdPhysics joint between two links (flipped: written child-first)."""
+    from lxml import etree
+
+    kind = KINDS.get(joint.GetTypeName())
+    name = names[str(joint.GetPath())]
+    if kind is None:
+        why = f"a {joint.GetTypeName() or 'generic'} joint: read as fixed"
+        ctx.listed.append((f"joints.{name}.type", why))
+        kind = "fixed"
+    element = etree.SubElement(robot, "joint", name=name, type=kind)
+    poses.origin(element, origin)
+    etree.SubElement(element, "parent", link=link_names[0])
+    etree.SubElement(element, "child", link=link_names[1])
+    if kind in ("revolute", "prismatic"):
+        _axis_limits(element, joint, kind, flip, ctx)
+    if kind == "spherical":
+        ctx.listed.append((f"joints.{name}.limits", "a spherical joint's cone limits: not read"))
+
+
+def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
+    """Axis (joint frame; flipped with the joint), limits (rad or m), effort, velocity."""
+    from lxml import etree
+
+    axis = np.zeros(3)
+    axis["XYZ".index(str(joint.GetAttribute("physics:axis").Get() or "X"))] = -1.0 if flip else 1.0
+    etree.SubElement(element, "axis", xyz=poses.fmt(axis))
+    low = poses.get(joint, "physics:lowerLimit")
+    high = poses.get(joint, "physics:upperLimit")
+    bounded = all(v is not None and abs(float(v)) < UNBOUNDED for v in (low, high))
+    scale = math.radians(1.0) if kind == "revolute" else ctx.units.meters
+    limit = {}
+    if bounded:
+        limit = {
+            "lower": poses.fmt([float(low) * scale]),
+            "upper": poses.fmt([float(high) * scale]),
+        }
+    elif kind == "revolute":
+        element.set("type", "continuous")
+    drive = "angular" if kind == "revolute" else "linear"
+    force = poses.get(joint, f"drive:{drive}:physics:maxForce")
+    if force is not None and 0 < float(force) < UNBOUNDED:
+        unit = (
+            ctx.units.kilograms
+            * ctx.units.meters
+            * (1 if kind == "prismatic" else ctx.units.meters)
+        )
+        limit["effort"] = poses.fmt([float(force) * unit])
+    speed = poses.get(joint, f"physxJointAxis:{drive}:maxJointVelocity")
+    speed = speed if speed is not None else poses.get(joint, "physxJoint:maxJointVelocity")
+    if speed is not None and 0 < float(speed) < UNBOUNDED:
+        limit["velocity"] = poses.fmt([float(speed) * scale])
+    if limit:
+        etree.SubElement(element, "limit", **limit)
