@@ -19,7 +19,7 @@ from types import ModuleType
 
 from simkit.check.findings import Finding
 from simkit.check.kit import Kit
-from simkit.check.source import mjcf, urdf
+from simkit.check.source import mjcf, urdf, usd
 from simkit.check.source.shared import Allowed, digest
 
 __all__ = ["COMPARE", "Allowed", "check_source", "format_of"]
@@ -27,7 +27,7 @@ __all__ = ["COMPARE", "Allowed", "check_source", "format_of"]
 #: robot.json `source.format` -> the module proving the kit is that source: its
 #: `compare(kit, path)` (the findings) and `remake(path, args)` (the kept file's bytes made
 #: from the original the user imported)
-COMPARE: dict[str, ModuleType] = {"urdf": urdf, "xacro": urdf, "mjcf": mjcf}
+COMPARE: dict[str, ModuleType] = {"urdf": urdf, "xacro": urdf, "mjcf": mjcf, "usd": usd}
 
 
 def format_of(doc: dict) -> str:

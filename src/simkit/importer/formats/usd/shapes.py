@@ -64,45 +64,53 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
     return notes
 
 
+def _f32(values) -> np.ndarray:
+    """Sizes made from float32 scales (xformOp:scale is float3) as the decimals written."""
+    return np.array([float(str(np.float32(v))) for v in np.ravel(values)])
+
+
 def _element(link, tag: str, prim, full: np.ndarray, ctx):
     """One `<collision>` or `<visual>` of a shape prim (transform `full` in the link
     frame, scale included); None for an empty mesh."""
     from lxml import etree
 
     kind = prim.GetTypeName()
-    rigid, scale = _rigid(full)
+    pose, scale = rigid(full)
     geometry = etree.Element("geometry")
     m = ctx.units.meters
     if kind == "Mesh":
         path = _stl(prim, full, ctx.scratch)
         if path is None:
             return None
-        rigid = np.eye(4)
+        pose = np.eye(4)
         etree.SubElement(geometry, "mesh", filename=str(path))
     elif kind == "Cube":
         size = float(prim.GetAttribute("size").Get() or 2.0) * m * scale
-        etree.SubElement(geometry, "box", size=poses.fmt(size))
+        etree.SubElement(geometry, "box", size=poses.fmt(_f32(size)))
     elif kind == "Sphere":
         radius = float(prim.GetAttribute("radius").Get() or 1.0) * m * float(np.max(scale))
-        etree.SubElement(geometry, "sphere", radius=poses.fmt([radius]))
+        etree.SubElement(geometry, "sphere", radius=poses.fmt(_f32([radius])))
     else:
         axis = str(prim.GetAttribute("axis").Get() or "Z")
         along = "XYZ".index(axis)
         across = [s for i, s in enumerate(scale) if i != along]
         radius = float(prim.GetAttribute("radius").Get() or 1.0) * m * float(max(across))
         height = float(prim.GetAttribute("height").Get() or 2.0) * m * float(scale[along])
-        rigid = rigid @ poses.make(_z_to(axis), np.zeros(3))
+        pose = pose @ poses.make(_z_to(axis), np.zeros(3))
         etree.SubElement(
-            geometry, kind.lower(), radius=poses.fmt([radius]), length=poses.fmt([height])
+            geometry,
+            kind.lower(),
+            radius=poses.fmt(_f32([radius])),
+            length=poses.fmt(_f32([height])),
         )
     element = etree.SubElement(link, tag, name=prim.GetName())
-    poses.origin(element, rigid)
+    poses.origin(element, pose)
     element.append(geometry)
     element.sourceline = 0
     return element
 
 
-def _rigid(full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def rigid(full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     scale = np.linalg.norm(full[:3, :3], axis=0)
     scale = np.where(scale > 0, scale, 1.0)
     u, _, vt = np.linalg.svd(full[:3, :3] / scale)

@@ -10,7 +10,7 @@ is turned round: the frames swap and its axis flips, its limits stay. The source
 
 Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prismatic (m),
 Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce` is the
-joint's effort, PhysX's `maxJointVelocity` (deg/s) its velocity. A joint with no body0 (or a
+joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) its velocity. A joint with no body0 (or a
 body0 that is no rigid body) joins the robot to the world: on the root body a fixed one bolts
 the base (a `world` link), another moves it. Other joint types, and a drive's stiffness and
 damping (the kit sizes its own servos), are listed. A joint with `excludeFromArticulation`
@@ -109,6 +109,9 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     for joint, parent, child, flip, origin in order:
         ends_ = (ctx.names[parent], ctx.names[child])
         _joint(robot, joint, joint_names, ends_, origin, ctx, flip)
+    for body in art.bodies:
+        if body in frames:
+            _frames(robot, body, frames[body], ctx)
     for joint in loops:
         a, b = ends(joint)
         if a in ctx.names and b in ctx.names:
@@ -162,6 +165,33 @@ def _walk(art: Articulation, root: str, ctx: Context):
             todo.append(other)
     loops += [j for j in tree_joints if id(j) not in used]
     return frames, order, loops, base
+
+
+def _frames(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
+    """Each Xform directly under the body with no shape and no body below it (a tool or
+    sensor frame): a massless link on a fixed joint `NAME_joint`, at its pose (m)."""
+    from lxml import etree
+    from pxr import Usd
+
+    prim = ctx.art.stage.GetPrimAtPath(body)
+    taken = {e.get("name") for e in robot.iter("link", "joint")}
+    every = Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)
+    for child in prim.GetFilteredChildren(every):
+        if child.GetTypeName() != "Xform" or str(child.GetPath()) in ctx.names:
+            continue
+        below = list(Usd.PrimRange(child, every))
+        if any(p.GetTypeName() in shapes.SHAPES or str(p.GetPath()) in ctx.names for p in below):
+            continue
+        name = child.GetName() if child.GetName() not in taken else f"{child.GetName()}_frame"
+        joint_name = f"{name}_joint" if f"{name}_joint" not in taken else f"{name}_frame_joint"
+        taken |= {name, joint_name}
+        pose = poses.relative(ctx.cache, child, prim, ctx.units.meters)
+        pose = poses.inv(frame) @ shapes.rigid(pose)[0]
+        joint = etree.SubElement(robot, "joint", name=joint_name, type="fixed")
+        poses.origin(joint, pose)
+        etree.SubElement(joint, "parent", link=ctx.names[body])
+        etree.SubElement(joint, "child", link=name)
+        etree.SubElement(robot, "link", name=name)
 
 
 def _world_origin(joint, ctx: Context) -> np.ndarray:
@@ -253,7 +283,8 @@ def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
         )
         limit["effort"] = poses.fmt([float(force) * unit])
     speed = poses.get(joint, f"physxJointAxis:{drive}:maxJointVelocity")
-    speed = speed if speed is not None else poses.get(joint, "physxJoint:maxJointVelocity")
+    for other in ("physxJoint:maxJointVelocity", "newton:velocityLimit"):
+        speed = speed if speed is not None else poses.get(joint, other)
     if speed is not None and 0 < float(speed) < UNBOUNDED:
         limit["velocity"] = poses.fmt([float(speed) * scale])
     if limit:

@@ -1,0 +1,88 @@
+"""USD import (issue 39): a UsdPhysics articulation read from the composed stage."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import yaml
+
+from simkit.errors import SpecError
+from simkit.importer import import_robot
+from simkit.importer.read.options import ReadOptions
+from tests.usd_stages import arm
+
+pytest.importorskip("pxr")
+
+
+def _spec(tmp_path, **kwargs) -> dict:
+    variant = kwargs.pop("pick", None)
+    path = arm(tmp_path / "arm.usda", **kwargs)
+    done = import_robot(path, tmp_path / "out", reading=ReadOptions(variant=variant))
+    return yaml.safe_load(done.spec_path.read_text())
+
+
+def _by_name(items: list[dict]) -> dict[str, dict]:
+    return {item["name"]: item for item in items}
+
+
+def test_two_link_arm(tmp_path) -> None:
+    """MassAPI masses, a revolute with limits in degrees, a prismatic, a fixed base."""
+    spec = _spec(tmp_path)
+    links, joints = _by_name(spec["links"]), _by_name(spec["joints"])
+    assert links["base"]["mass"] == 2.0 and links["upper"]["mass"] == 1.0
+    assert links["upper"]["com"] == pytest.approx([0, 0, 0.1])
+    assert joints["shoulder"]["type"] == "revolute"
+    assert joints["shoulder"]["lower"] == pytest.approx(math.radians(-90))
+    assert joints["shoulder"]["upper"] == pytest.approx(math.radians(45))
+    assert joints["shoulder"]["xyz"] == pytest.approx([0, 0, 0.5])
+    assert joints["slide"]["type"] == "prismatic" and joints["slide"]["upper"] == pytest.approx(0.2)
+    assert joints["world_joint"]["parent"] == "world" and spec["root"] == "world"
+    assert spec["source"]["format"] == "usd"
+
+
+def test_centimetres(tmp_path) -> None:
+    """metersPerUnit 0.01: lengths (joint origins, limits, CoM) scaled to metres."""
+    spec = _spec(tmp_path, meters=0.01)
+    joints, links = _by_name(spec["joints"]), _by_name(spec["links"])
+    assert joints["shoulder"]["xyz"] == pytest.approx([0, 0, 0.5])
+    assert joints["slide"]["upper"] == pytest.approx(0.2)
+    assert links["upper"]["com"] == pytest.approx([0, 0, 0.1])
+    assert links["upper"]["inertia"]["izz"] == pytest.approx(0.03, rel=1e-6)
+
+
+def test_y_up(tmp_path) -> None:
+    """A Y-up stage is turned Z up where the robot meets the world (the base joint)."""
+    spec = _spec(tmp_path, y_up=True)
+    base = _by_name(spec["joints"])["world_joint"]
+    assert base.get("rpy", [0, 0, 0]) == pytest.approx([math.pi / 2, 0, 0])
+
+
+def test_variant(tmp_path) -> None:
+    """The default Physics variant, and the one --variant names; an unknown one refused."""
+    assert _by_name(_spec(tmp_path / "a", variant=True)["links"])["upper"]["mass"] == 1.0
+    heavy = _spec(tmp_path / "b", variant=True, pick="heavy")
+    assert _by_name(heavy["links"])["upper"]["mass"] == 3.0
+    assert heavy["source"]["args"] == {"variant": "heavy"}
+    with pytest.raises(SpecError, match="no Physics variant 'nope'"):
+        _spec(tmp_path / "c", variant=True, pick="nope")
+
+
+def test_no_articulation(tmp_path) -> None:
+    from pxr import Usd, UsdGeom
+
+    path = tmp_path / "empty.usda"
+    stage = Usd.Stage.CreateNew(str(path))
+    UsdGeom.Xform.Define(stage, "/thing")
+    stage.GetRootLayer().Save()
+    with pytest.raises(SpecError, match="no articulation") as caught:
+        import_robot(path, tmp_path / "out")
+    assert "\n" not in str(caught.value)
+    assert not (tmp_path / "out").exists()
+
+
+def test_two_robots(tmp_path) -> None:
+    path = arm(tmp_path / "two.usda", robots=2)
+    with pytest.raises(SpecError, match="several robots") as caught:
+        import_robot(path, tmp_path / "out")
+    assert "\n" not in str(caught.value)

@@ -1,0 +1,86 @@
+"""Small UsdPhysics stages written with pxr for the USD import tests (issue 39)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def arm(
+    path: Path,
+    meters: float = 1.0,
+    y_up: bool = False,
+    robots: int = 1,
+    articulated: bool = True,
+    variant: bool = False,
+) -> Path:
+    """A fixed-base two-link arm per robot: `base` (box, MassAPI 2 kg) bolted to the world,
+    `upper` on a revolute joint about Z (-90..45 degrees), `slider` on a prismatic joint
+    along X (0..0.2 m, stage units); with `variant`, a `Physics` variant set whose
+    `heavy` variant sets `upper`'s mass to 3 kg (default `light`: 1 kg)."""
+    from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
+
+    stage = Usd.Stage.CreateNew(str(path))
+    UsdGeom.SetStageMetersPerUnit(stage, meters)
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y if y_up else UsdGeom.Tokens.z)
+    unit = 1.0 / meters
+    for r in range(robots):
+        top = UsdGeom.Xform.Define(stage, f"/arm{r}")
+        stage.SetDefaultPrim(top.GetPrim())
+        if articulated:
+            UsdPhysics.ArticulationRootAPI.Apply(top.GetPrim())
+        top.AddTranslateOp().Set(Gf.Vec3d(r * 2 * unit, 0, 0))
+        bodies = {}
+        for name, z, mass in (("base", 0.0, 2.0), ("upper", 0.5, 1.0), ("slider", 1.0, 0.5)):
+            xf = UsdGeom.Xform.Define(stage, f"/arm{r}/{name}")
+            xf.AddTranslateOp().Set(Gf.Vec3d(0, 0, z * unit))
+            UsdPhysics.RigidBodyAPI.Apply(xf.GetPrim())
+            api = UsdPhysics.MassAPI.Apply(xf.GetPrim())
+            api.CreateMassAttr(mass)
+            api.CreateCenterOfMassAttr(Gf.Vec3f(0, 0, 0.1 * unit))
+            api.CreateDiagonalInertiaAttr(Gf.Vec3f(0.01, 0.02, 0.03) * unit * unit)
+            cube = UsdGeom.Cube.Define(stage, f"/arm{r}/{name}/box")
+            cube.CreateSizeAttr(0.1 * unit)
+            UsdPhysics.CollisionAPI.Apply(cube.GetPrim())
+            cube.CreateDisplayColorAttr([Gf.Vec3f(0.2, 0.4, 0.6)])
+            bodies[name] = xf.GetPath()
+        _joints(stage, f"/arm{r}", bodies, unit)
+        if variant:
+            _variant(stage, top.GetPrim(), f"/arm{r}/upper")
+    stage.GetRootLayer().Save()
+    return path
+
+
+def _joints(stage, at: str, bodies: dict, unit: float) -> None:
+    from pxr import Gf, UsdPhysics
+
+    fixed = UsdPhysics.FixedJoint.Define(stage, f"{at}/world_joint")
+    fixed.CreateBody1Rel().SetTargets([bodies["base"]])
+    hinge = UsdPhysics.RevoluteJoint.Define(stage, f"{at}/shoulder")
+    hinge.CreateBody0Rel().SetTargets([bodies["base"]])
+    hinge.CreateBody1Rel().SetTargets([bodies["upper"]])
+    hinge.CreateLocalPos0Attr(Gf.Vec3f(0, 0, 0.5 * unit))
+    hinge.CreateAxisAttr("Z")
+    hinge.CreateLowerLimitAttr(-90.0)
+    hinge.CreateUpperLimitAttr(45.0)
+    drive = UsdPhysics.DriveAPI.Apply(hinge.GetPrim(), "angular")
+    drive.CreateMaxForceAttr(20.0)
+    slide = UsdPhysics.PrismaticJoint.Define(stage, f"{at}/slide")
+    slide.CreateBody0Rel().SetTargets([bodies["upper"]])
+    slide.CreateBody1Rel().SetTargets([bodies["slider"]])
+    slide.CreateLocalPos0Attr(Gf.Vec3f(0, 0, 0.5 * unit))
+    slide.CreateAxisAttr("X")
+    slide.CreateLowerLimitAttr(0.0)
+    slide.CreateUpperLimitAttr(0.2 * unit)
+
+
+def _variant(stage, prim, upper: str) -> None:
+    from pxr import UsdPhysics
+
+    UsdPhysics.MassAPI(stage.GetPrimAtPath(upper)).GetMassAttr().Clear()  # the variants say
+    variants = prim.GetVariantSets().AddVariantSet("Physics")
+    for name, mass in (("heavy", 3.0), ("light", 1.0)):
+        variants.AddVariant(name)
+        variants.SetVariantSelection(name)
+        with variants.GetVariantEditContext():
+            UsdPhysics.MassAPI(stage.GetPrimAtPath(upper)).GetMassAttr().Set(mass)
+    variants.SetVariantSelection("light")
