@@ -4,9 +4,9 @@
     python scripts/usd_corpus.py CORPUS_DIR [--mjcf] [--only GLOB ...] [--exclude GLOB ...]
         [--venv DIR] [--out DIR] [--build] [--limit N] [--title TITLE] [--md FILE]
 
-Each robot file (`*.urdf` with a movable joint; with `--mjcf` the `*.xml` whose root is `<mujoco>` and that has a
-joint) is converted with its default flags by `urdf_usd_converter FILE DIR` or
-`mujoco_usd_converter FILE DIR` from the converters' own venv (`--venv`, default
+Each robot file (`*.urdf` with a movable joint; with `--mjcf` the `*.xml` whose root is
+`<mujoco>` and that has a joint) is converted with its default flags by
+`urdf_usd_converter FILE DIR` or `mujoco_usd_converter FILE DIR` from the converters' own venv (`--venv`, default
 ~/.cache/simkit-ci/venv-usdconv: they pin their own usd-core), then `simkit import DIR/X.usda`
 (no flag), and the imported spec compared with the original, read by yourdfpy (URDF) or
 compiled by MuJoCo (MJCF), independently of both converter and importer:
@@ -100,7 +100,7 @@ def one(path: Path, root: Path, work: Path, args) -> dict:
     slug = re.sub(r"[^A-Za-z0-9]+", "_", rel).strip("_").lower()
     row = {"file": rel, "step": "convert", "ok": False, "why": ""}
     conv = work / slug / "usd"
-    tool = VENV_DIR(args) / "bin" / ("mujoco_usd_converter" if args.mjcf else "urdf_usd_converter")
+    tool = venv_dir(args) / "bin" / ("mujoco_usd_converter" if args.mjcf else "urdf_usd_converter")
     code, text = _run([str(tool), str(path), str(conv)], args.timeout)
     usdas = sorted(conv.glob("*.usda")) if conv.is_dir() else []
     if code or not usdas:
@@ -135,7 +135,8 @@ def one(path: Path, root: Path, work: Path, args) -> dict:
     return row
 
 
-def VENV_DIR(args) -> Path:  # noqa: N802 - the converters' venv
+def venv_dir(args) -> Path:
+    """The converters' venv."""
     return Path(args.venv)
 
 

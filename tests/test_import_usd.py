@@ -6,11 +6,11 @@ import math
 
 import pytest
 import yaml
+from tests.usd_stages import arm
 
 from simkit.errors import SpecError
 from simkit.importer import import_robot
 from simkit.importer.read.options import ReadOptions
-from tests.usd_stages import arm
 
 pytest.importorskip("pxr")
 

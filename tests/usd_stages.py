@@ -17,7 +17,7 @@ def arm(
     `upper` on a revolute joint about Z (-90..45 degrees), `slider` on a prismatic joint
     along X (0..0.2 m, stage units); with `variant`, a `Physics` variant set whose
     `heavy` variant sets `upper`'s mass to 3 kg (default `light`: 1 kg)."""
-    from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
+    from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
     stage = Usd.Stage.CreateNew(str(path))
     UsdGeom.SetStageMetersPerUnit(stage, meters)

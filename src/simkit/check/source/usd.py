@@ -11,8 +11,8 @@ Compared, under the source's prim names (made unique in path order, renames from
   1e-6 in rotation): the source's composed from the parser's joint frames
   (body1 = body0 * localPose0 * motion(q) * localPose1^-1), the kit's from its URDF.
 
-Frames: the kit's link frame of a body is its body frame moved by the joint frame on it
-(importer/formats/usd/tree.py); this check finds that frame from the parser's joints and
+Frames: the kit's link frame of a body is its body frame moved (not turned) to the joint
+frame on it (importer/formats/usd/tree.py); this check finds that frame from the parser's joints and
 the same breadth-first walk. A difference passes only where `source_differences` lists it.
 """
 
@@ -165,9 +165,10 @@ def _bodies(source: Robot, built, allowed: Allowed) -> list[str]:
             continue
         pose = body.frame @ np.asarray(inertial.origin, dtype=float)
         com = pose[:3, 3]
-        if body.com is not None and f"{key}.com" not in allowed.keys:
-            if np.max(np.abs(com - body.com)) > REL * np.max(np.abs(body.com)) + ABS_LENGTH:
-                out.append(f"link '{name}': CoM {_v(body.com)} m in the USD, {_v(com)} in the kit")
+        far = None if body.com is None else np.max(np.abs(com - body.com))
+        bound = 0.0 if body.com is None else REL * np.max(np.abs(body.com)) + ABS_LENGTH
+        if far is not None and f"{key}.com" not in allowed.keys and far > bound:
+            out.append(f"link '{name}': CoM {_v(body.com)} m in the USD, {_v(com)} in the kit")
         if body.inertia is not None and f"{key}.inertia" not in allowed.keys:
             tensor = pose[:3, :3] @ np.asarray(inertial.inertia) @ pose[:3, :3].T
             if not inertia_close(body.inertia, tensor):
@@ -340,8 +341,8 @@ def source_robot(path: Path, variant: str | None) -> Robot:
                     sets.GetVariantSet("Physics").SetVariantSelection(variant)
     meters = float(UsdGeom.GetStageMetersPerUnit(stage)) or 1.0
     kilograms = float(UsdPhysics.GetStageKilogramsPerUnit(stage)) or 1.0
-    load = getattr(UsdPhysics, "LoadUsdPhysicsFromRange")
-    parsed = load(stage, ["/"])
+    load = getattr(UsdPhysics, "UsdPhysicsLoadStageFromPrimRange", None)
+    parsed = (load or UsdPhysics.LoadUsdPhysicsFromRange)(stage, ["/"])
     kinds = {
         UsdPhysics.ObjectType.RevoluteJoint: "revolute",
         UsdPhysics.ObjectType.PrismaticJoint: "prismatic",
@@ -405,6 +406,8 @@ def _mass_of(prim, meters: float, kilograms: float) -> Body:
             q = axes.Get()
             turn = _quat(float(q.GetReal()), *(float(v) for v in q.GetImaginary()))
         body.inertia = turn @ moments @ turn.T * kilograms * meters * meters
+        if body.com is None and body.mass is not None:
+            body.com = np.zeros(3)  # inertia about a CoM left unwritten: the body origin
     return body
 
 
@@ -426,7 +429,7 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
         root = next(n for n in sorted(bodies) if n not in children and _touches(n, inner))
     for _, j in world:
         if root in (j.body0, j.body1) and (j.body0 in bodies) != (j.body1 in bodies):
-            robot.bodies[root].frame = j.pose1 if j.body1 == root else j.pose0
+            robot.bodies[root].frame = _moved(j.pose1 if j.body1 == root else j.pose0)
             break
     robot.root, todo, seen = root, [root], {root}
     while todo:
@@ -439,9 +442,16 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
             if other in seen:
                 continue
             seen.add(other)
-            robot.bodies[other].frame = j.pose0 if flip else j.pose1
+            robot.bodies[other].frame = _moved(j.pose0 if flip else j.pose1)
             robot.tree.append((name, flip))
             todo.append(other)
+
+
+def _moved(pose: np.ndarray) -> np.ndarray:
+    """The kit's link frame of a body whose joint frame is `pose`: moved there, not turned."""
+    out = np.eye(4)
+    out[:3, 3] = pose[:3, 3]
+    return out
 
 
 def _touches(name: str, joints: dict) -> bool:

@@ -1,5 +1,10 @@
 """A body's mass properties in its link frame: UsdPhysics MassAPI where authored, else the
-solid of its collision shapes at the body's density (tree.py's module docstring)."""
+solid of its collision shapes at the body's density (tree.py's module docstring).
+
+A MassAPI that gives the mass and the principal moments but no `centerOfMass` puts the CoM at
+the body's origin: the author computed the inertia about a point, and the converters that
+write mass properties (NVIDIA's urdf-usd-converter) leave a zero CoM unwritten. Without the
+inertia, the CoM (and inertia) come from the colliders' solid, as UsdPhysics says."""
 
 from __future__ import annotations
 
@@ -40,6 +45,9 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
                 "no MassAPI mass: the colliders' solid at its density",
             )
         )
+    given = diagonal is not None and np.any(np.asarray(diagonal) > 0)
+    if given and kg > 0 and (com is None or not np.all(np.asarray(com) > UNSET)):
+        com = (0.0, 0.0, 0.0)  # inertia given about a CoM left unwritten: the body origin
     if com is not None and np.all(np.asarray(com) > UNSET):
         scale = poses.world(ctx.cache, prim, 1.0)[1]
         centre = to_link[:3, :3] @ (np.asarray(com, float) * scale * ctx.units.meters)

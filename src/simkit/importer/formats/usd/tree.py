@@ -2,17 +2,20 @@
 
 Frames: a UsdPhysics joint joins body0's frame `localPos0/localRot0` to body1's
 `localPos1/localRot1`, and turns about its `axis` (X, Y or Z) of that joint frame. A URDF
-joint turns about its child link's origin, so a link's frame is its body's frame moved by the
-joint frame on it (`localPose1` of the joint it hangs from; the root's own body frame, or
-its world joint's `localPose1`). A joint written child-first (its body0 further from the root)
-is turned round: the frames swap and its axis flips, its limits stay. The source check
+joint turns about its child link's origin, so a link's frame is its body's frame moved (not
+turned) to the joint frame on it (`localPos1` of the joint it hangs from; the root's own body
+frame, or its world joint's `localPos1`); the joint's axis is `localRot1` applied to X, Y or Z,
+in the link's axes, and its origin `localPose0` turned back by `localRot1`. So a URDF whose
+link frames a converter kept reads back with those frames. A joint written child-first (its
+body0 further from the root) is turned round: the frames swap and its axis flips, its limits
+stay. The source check
 (check/source/usd.py) applies the same rule to usd-core's own physics parser.
 
 Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prismatic (m),
 Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce` is the
-joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) its velocity. A joint with no body0 (or a
-body0 that is no rigid body) joins the robot to the world: on the root body a fixed one bolts
-the base (a `world` link), another moves it. Other joint types, and a drive's stiffness and
+joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) its
+velocity. A joint with no body0 (or a body0 that is no rigid body) joins the robot to the
+world: on the root body a fixed one bolts the base (a `world` link), another moves it. Other joint types, and a drive's stiffness and
 damping (the kit sizes its own servos), are listed. A joint with `excludeFromArticulation`
 or one closing a loop is emitted after the tree, so the URDF repair `second_parents` leaves
 it out (listed as dropped).
@@ -56,6 +59,8 @@ class Context:
     names: dict[str, str] = field(default_factory=dict)
     listed: list[tuple[str, str]] = field(default_factory=list)
     dropped: list[tuple[object, str]] = field(default_factory=list)
+    #: id(joint) -> its frame's turn in the child's body axes (the axis is turned by it)
+    turns: dict[int, np.ndarray] = field(default_factory=dict)
 
 
 def unique_names(paths: list[str]) -> dict[str, str]:
@@ -115,7 +120,10 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     for joint in loops:
         a, b = ends(joint)
         if a in ctx.names and b in ctx.names:
+            there = local_pose(joint, 1, ctx)
+            ctx.turns[id(joint)] = there[:3, :3]
             origin = poses.inv(frames.get(a, np.eye(4))) @ local_pose(joint, 0, ctx)
+            origin = origin @ _turn_back(there)
             _joint(robot, joint, joint_names, (ctx.names[a], ctx.names[b]), origin, ctx)
         else:
             ctx.dropped.append((joint, "joins the robot to the world away from its root"))
@@ -146,7 +154,7 @@ def _walk(art: Articulation, root: str, ctx: Context):
     frames[root] = np.eye(4)
     if base is not None:
         end = 1 if ends(base)[1] == root else 0
-        frames[root] = local_pose(base, end, ctx)
+        frames[root] = _at(local_pose(base, end, ctx))
     todo, used = [root], set()
     while todo:
         body = todo.pop(0)
@@ -159,8 +167,10 @@ def _walk(art: Articulation, root: str, ctx: Context):
                 continue
             used.add(id(joint))
             near, far = (1, 0) if flip else (0, 1)
-            origin = poses.inv(frames[body]) @ local_pose(joint, near, ctx)
-            frames[other] = local_pose(joint, far, ctx)
+            there = local_pose(joint, far, ctx)
+            origin = poses.inv(frames[body]) @ local_pose(joint, near, ctx) @ _turn_back(there)
+            frames[other] = _at(there)
+            ctx.turns[id(joint)] = there[:3, :3]
             order.append((joint, body, other, flip, origin))
             todo.append(other)
     loops += [j for j in tree_joints if id(j) not in used]
@@ -182,8 +192,11 @@ def _frames(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
         below = list(Usd.PrimRange(child, every))
         if any(p.GetTypeName() in shapes.SHAPES or str(p.GetPath()) in ctx.names for p in below):
             continue
-        name = child.GetName() if child.GetName() not in taken else f"{child.GetName()}_frame"
-        joint_name = f"{name}_joint" if f"{name}_joint" not in taken else f"{name}_frame_joint"
+        name, n = child.GetName(), 0
+        while name in taken or f"{name}_joint" in taken:
+            n += 1
+            name = f"{child.GetName()}_{n}"
+        joint_name = f"{name}_joint"
         taken |= {name, joint_name}
         pose = poses.relative(ctx.cache, child, prim, ctx.units.meters)
         pose = poses.inv(frame) @ shapes.rigid(pose)[0]
@@ -204,7 +217,17 @@ def _world_origin(joint, ctx: Context) -> np.ndarray:
     if prim:
         at = poses.world(ctx.cache, prim, ctx.units.meters)[0]
     up = poses.make(ctx.units.up, np.zeros(3))
-    return up @ at @ local_pose(joint, end, ctx)
+    return up @ at @ local_pose(joint, end, ctx) @ _turn_back(local_pose(joint, 1 - end, ctx))
+
+
+def _at(pose: np.ndarray) -> np.ndarray:
+    """The link frame a joint frame gives its body: moved to the joint, not turned."""
+    return poses.make(np.eye(3), pose[:3, 3])
+
+
+def _turn_back(pose: np.ndarray) -> np.ndarray:
+    """The inverse of a joint frame's turn: the joint's origin then ends in the link's axes."""
+    return poses.make(pose[:3, :3].T, np.zeros(3))
 
 
 def _link(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
@@ -260,7 +283,8 @@ def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
 
     axis = np.zeros(3)
     axis["XYZ".index(str(joint.GetAttribute("physics:axis").Get() or "X"))] = -1.0 if flip else 1.0
-    etree.SubElement(element, "axis", xyz=poses.fmt(axis))
+    axis = ctx.turns.get(id(joint), np.eye(3)) @ axis
+    etree.SubElement(element, "axis", xyz=poses.fmt(np.where(np.abs(axis) < 1e-15, 0.0, axis)))
     low = poses.get(joint, "physics:lowerLimit")
     high = poses.get(joint, "physics:upperLimit")
     bounded = all(v is not None and abs(float(v)) < UNBOUNDED for v in (low, high))
