@@ -6,7 +6,8 @@
 
 Each robot file (`*.urdf` with a movable joint; with `--mjcf` the `*.xml` whose root is
 `<mujoco>` and that has a joint) is converted with its default flags by
-`urdf_usd_converter FILE DIR` or `mujoco_usd_converter FILE DIR` from the converters' own venv (`--venv`, default
+`urdf_usd_converter FILE DIR` or `mujoco_usd_converter FILE DIR` from the converters' own
+venv (`--venv`, default
 ~/.cache/simkit-ci/venv-usdconv: they pin their own usd-core), then `simkit import DIR/X.usda`
 (no flag), and the imported spec compared with the original, read by yourdfpy (URDF) or
 compiled by MuJoCo (MJCF), independently of both converter and importer:
