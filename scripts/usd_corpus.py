@@ -14,7 +14,8 @@ compiled by MuJoCo (MJCF), independently of both converter and importer:
 
 - each original body of positive mass: its mass (1e-6 relative) in the spec under the same
   name (names made USD identifiers, as the converters make them; renames from the spec's
-  `source_differences`);
+  `source_differences`); a value the import estimated (the spec's `estimated`: a zero
+  inertia, a missing limit) is the import's, as for a URDF import, and not compared;
 - each original movable joint: its type (revolute, continuous, prismatic) and limits;
 - at 20 seeded configurations (hinge and slide joints in their limits, balls and free joints
   at rest), every massive body's centre of mass (1e-6 m) and inertia tensor in the root
@@ -247,7 +248,7 @@ def _compare_bodies(kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn) 
         link = kit.links.get(kit.name("links", name))
         if link is None:
             out.append(f"link {name} missing")
-        elif not _close(link.get("mass", 0), mass, mass, 0):
+        elif "mass" not in link.get("estimated", []) and not _close(link["mass"], mass, mass, 0):
             out.append(
                 f"link {name}: mass {mass:.9g} in the original, {link.get('mass')} in the kit"
             )
@@ -258,7 +259,7 @@ def _compare_bodies(kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn) 
             continue
         if joint["type"] != kind:
             out.append(f"joint {name}: {kind} in the original, {joint['type']} in the kit")
-        elif limits is not None:
+        elif limits is not None and not {"lower", "upper"} & set(joint.get("estimated", [])):
             got = (joint.get("lower"), joint.get("upper"))
             if None in got or not _close(got, limits, max(map(abs, limits)), 1e-9):
                 out.append(f"joint {name}: limits {limits} in the original, {got} in the kit")
@@ -273,10 +274,12 @@ def _compare_bodies(kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn) 
             if link not in poses:
                 return [f"link {name} not in the kit's tree"]
             got_com, got_tensor = kit.com_world(poses, link)
-            if not _close(got_com, com, 1.0, TOL):
+            estimated = set(kit.links[link].get("estimated", []))
+            if "com" not in estimated and not _close(got_com, com, 1.0, TOL):
                 far = float(np.max(np.abs(got_com - com)))
                 return [f"link {name}: CoM off by {far:.3g} m at a seeded configuration"]
-            if not _close(got_tensor, tensor, float(np.linalg.norm(tensor)), 1e-12):
+            scale = float(np.linalg.norm(tensor))
+            if "inertia" not in estimated and not _close(got_tensor, tensor, scale, 1e-12):
                 return [f"link {name}: inertia (root frame) differs at a seeded configuration"]
     return out
 
