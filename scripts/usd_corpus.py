@@ -286,9 +286,14 @@ def _compare_bodies(kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn) 
 
 def compare_urdf(path: Path, spec: dict) -> list[str]:
     """The spec against the original URDF (yourdfpy)."""
+    import tempfile
+
     from simkit.check.source.urdf import load_urdf
 
-    robot = load_urdf(path, [])
+    with tempfile.TemporaryDirectory() as tmp:  # yourdfpy's parser wants no text before <?xml
+        clean = Path(tmp) / path.name
+        clean.write_bytes(path.read_bytes().lstrip())
+        robot = load_urdf(clean, [])
     kit = Kit(spec)
     bodies = {}
     for link in robot.links:

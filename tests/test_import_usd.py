@@ -86,3 +86,15 @@ def test_two_robots(tmp_path) -> None:
     with pytest.raises(SpecError, match="several robots") as caught:
         import_robot(path, tmp_path / "out")
     assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("excluded", [True, False])
+def test_closed_loop_dropped(tmp_path, excluded: bool) -> None:
+    """A loop-closing joint (excludeFromArticulation, or a body's second parent joint) is
+    left out of the kit's tree, one report line, listed in source_differences."""
+    path = arm(tmp_path / "arm.usda", loop=excluded)
+    done = import_robot(path, tmp_path / "out")
+    spec = yaml.safe_load(done.spec_path.read_text())
+    assert "zloop" not in _by_name(spec["joints"])
+    assert "joints.zloop" in {d["what"] for d in spec["source_differences"]}
+    assert any("zloop" in line and "closed loop" in line for line in done.lines)

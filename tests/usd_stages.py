@@ -12,11 +12,14 @@ def arm(
     robots: int = 1,
     articulated: bool = True,
     variant: bool = False,
+    loop: bool | None = None,
 ) -> Path:
     """A fixed-base two-link arm per robot: `base` (box, MassAPI 2 kg) bolted to the world,
     `upper` on a revolute joint about Z (-90..45 degrees), `slider` on a prismatic joint
     along X (0..0.2 m, stage units); with `variant`, a `Physics` variant set whose
-    `heavy` variant sets `upper`'s mass to 3 kg (default `light`: 1 kg)."""
+    `heavy` variant sets `upper`'s mass to 3 kg (default `light`: 1 kg); with `loop` a
+    fixed joint `loop` from `base` to `slider` closes a loop (True: marked
+    excludeFromArticulation; False: not marked, so `slider` has two parent joints)."""
     from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
     stage = Usd.Stage.CreateNew(str(path))
@@ -44,6 +47,12 @@ def arm(
             cube.CreateDisplayColorAttr([Gf.Vec3f(0.2, 0.4, 0.6)])
             bodies[name] = xf.GetPath()
         _joints(stage, f"/arm{r}", bodies, unit)
+        if loop is not None:
+            closing = UsdPhysics.FixedJoint.Define(stage, f"/arm{r}/zloop")
+            closing.CreateBody0Rel().SetTargets([bodies["base"]])
+            closing.CreateBody1Rel().SetTargets([bodies["slider"]])
+            closing.CreateLocalPos0Attr(Gf.Vec3f(0, 0, 1.0 * unit))
+            closing.CreateExcludeFromArticulationAttr(loop)
         if variant:
             _variant(stage, top.GetPrim(), f"/arm{r}/upper")
     stage.GetRootLayer().Save()

@@ -245,6 +245,7 @@ class Joint:
     pose1: np.ndarray
     axis: int = 0
     limits: tuple[float, float] | None = None
+    path: str = ""
 
 
 @dataclass
@@ -368,6 +369,7 @@ def source_robot(path: Path, variant: str | None) -> Robot:
         if label in ("revolute", "prismatic"):
             joint.axis = "XYZ".index(str(d.axis).rsplit(".", 1)[-1][-1])
             joint.limits = _limits_of(d.limit, label, meters)
+        joint.path = at
         if not d.excludeFromArticulation:
             robot.joints[joint_names[at]] = joint
     for at, name in names.items():
@@ -419,8 +421,16 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
     bodies = set(names.values())
     roots = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.ArticulationRootAPI)]
     root = names.get(str(roots[0].GetPath())) if roots else None
-    inner = {n: j for n, j in robot.joints.items() if j.body0 in bodies and j.body1 in bodies}
-    world = [(n, j) for n, j in sorted(robot.joints.items()) if n not in inner]
+    inner, claimed = {}, set()
+    for n, j in sorted(robot.joints.items(), key=lambda item: item[1].path):
+        if j.body0 in bodies and j.body1 in bodies and j.body1 not in claimed:
+            claimed.add(j.body1)  # a body's second parent joint closes a loop: not in the tree
+            inner[n] = j
+    world = [
+        (n, j)
+        for n, j in sorted(robot.joints.items())
+        if (j.body0 in bodies) != (j.body1 in bodies)
+    ]
     for _, j in world:
         if root is None and (j.body0 in bodies) != (j.body1 in bodies):
             root = j.body1 if j.body1 in bodies else j.body0

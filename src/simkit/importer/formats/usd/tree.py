@@ -16,9 +16,9 @@ Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce`
 joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) its
 velocity. A joint with no body0 (or a body0 that is no rigid body) joins the robot to the
 world: on the root body a fixed one bolts the base (a `world` link), another moves it.
-Other joint types, and a drive's stiffness and
-damping (the kit sizes its own servos), are listed. A joint with `excludeFromArticulation`
-or one closing a loop is emitted after the tree, so the URDF repair `second_parents` leaves
+Other joint types, and a drive's stiffness and damping (the kit sizes its own servos), are
+listed. A joint with `excludeFromArticulation`, or one closing a loop (a body's second parent
+joint, in path order), is emitted after the tree, so the URDF repair `second_parents` leaves
 it out (listed as dropped).
 
 Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
@@ -141,16 +141,17 @@ def _walk(art: Articulation, root: str, ctx: Context):
     bodies = set(art.bodies)
     frames: dict[str, np.ndarray] = {}
     base, loops, order = None, [], []
-    tree_joints = []
+    tree_joints, claimed = [], set()
     for joint in art.joints:
         a, b = ends(joint)
         excluded = bool(UsdPhysics.Joint(joint).GetExcludeFromArticulationAttr().Get())
         world = (a not in bodies) != (b not in bodies)
         if world and base is None and root in (a, b) and not excluded:
             base = joint
-        elif world or excluded:
-            loops.append(joint)
+        elif world or excluded or b in claimed:
+            loops.append(joint)  # a body's second parent joint (path order) closes a loop
         else:
+            claimed.add(b)
             tree_joints.append(joint)
     frames[root] = np.eye(4)
     if base is not None:
