@@ -315,7 +315,7 @@ def compare_urdf(path: Path, spec: dict) -> list[str]:
         q = {}
         for j in robot.joints:
             if j.type in ("revolute", "continuous", "prismatic") and j.mimic is None:
-                lo, hi = joints[j.name][1] or (-math.pi, math.pi)
+                lo, hi = sorted(joints[j.name][1] or (-math.pi, math.pi))
                 q[j.name] = float(rng.uniform(lo, hi))
         for j in robot.joints:
             if j.mimic is not None and j.mimic.joint in q:
@@ -383,7 +383,7 @@ def compare_mjcf(path: Path, spec: dict) -> list[str]:
             jn = model.joint(j).name or f"jnt{j}"
             if jn not in joints:
                 continue
-            lo, hi = joints[jn][1] or (-math.pi, math.pi)
+            lo, hi = sorted(joints[jn][1] or (-math.pi, math.pi))
             value = float(rng.uniform(lo, hi))
             adr = model.jnt_qposadr[j]
             data.qpos[adr] = value
