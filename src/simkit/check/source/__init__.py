@@ -2,9 +2,10 @@
 
 robot.json's `source.format` (the import's formats.FORMATS row) picks the comparison in
 `COMPARE`, one module per format, each reading the source with an implementation other than
-the importer's reader: urdf.py (yourdfpy; a xacro's kept source is its expansion, a URDF)
-and mjcf.py (MuJoCo compiles both the source and the kit's MJCF). Both also compare the
-source with the kit's USD (kit_usd.py). First the given file's digest is checked against the
+the importer's reader: urdf.py (yourdfpy; a xacro's kept source is its expansion, a URDF),
+mjcf.py (MuJoCo compiles both the source and the kit's MJCF) and usd.py (usd-core's
+UsdPhysics parser reads the composed stage). Each also compares the source with the kit's
+USD (kit_usd.py). First the given file's digest is checked against the
 one the import recorded, or the original's (shared.py): the file the user imported (a URDF,
 a xacro expanded with the recorded args) is read again as the import read it, and must give
 the kept file. A kit imported before robot.json named the format is read by its kept

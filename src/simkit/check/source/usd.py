@@ -28,6 +28,7 @@ import numpy as np
 
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
+from simkit.check.source import kit_usd
 from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
 from simkit.check.source.urdf import load_urdf
 from simkit.kitio.oneline import one_line
@@ -68,7 +69,21 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
     out = _findings("source.joints", _joints(source, built, allowed), _said(source, "joints"))
     out += _findings("source.links", _bodies(source, built, allowed), _said(source, "links"))
     fk = _fk(source, built, allowed)
-    return out + _findings("source.fk", fk, f"every body's pose agrees at {SEEDS} configurations")
+    out += _findings("source.fk", fk, f"every body's pose agrees at {SEEDS} configurations")
+    return out + kit_usd.compare(kit, _for_kit_usd(source), allowed)
+
+
+def _for_kit_usd(source: Robot) -> tuple[dict[str, float], dict[str, tuple]]:
+    """The source's ({body: mass}, {joint: (kind, limits in deg or m)}) for kit_usd.py."""
+    masses = {n: b.mass for n, b in source.bodies.items() if b.mass is not None}
+    joints = {}
+    for name, j in source.joints.items():
+        if j.kind in ("revolute", "prismatic"):
+            span = j.limits
+            if span is not None and j.kind == "revolute":
+                span = (math.degrees(span[0]), math.degrees(span[1]))
+            joints[name] = (j.kind, span)
+    return masses, joints
 
 
 def _said(source: Robot, what: str) -> str:

@@ -17,9 +17,9 @@ joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) i
 velocity. A joint with no body0 (or a body0 that is no rigid body) joins the robot to the
 world: on the root body a fixed one bolts the base (a `world` link), another moves it.
 Other joint types are read as fixed and listed; a drive's stiffness and damping are not read
-(the kit sizes its own servos). A joint with `excludeFromArticulation`, or one closing a loop (a body's second parent
-joint, in path order), is emitted after the tree, so the URDF repair `second_parents` leaves
-it out (listed as dropped).
+(the kit sizes its own servos). A joint with `excludeFromArticulation`, or one closing a
+loop (a body's second parent joint, in path order), is emitted after the tree, so the URDF
+repair `second_parents` leaves it out (listed as dropped).
 
 Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
 frame; where the mass is not authored, the collision shapes' solid at the MassAPI `density`
