@@ -9,11 +9,11 @@ import math
 
 import pytest
 import yaml
+from tests.usd_stages import arm
 
 from simkit.check.kit import Kit
 from simkit.check.source import usd as source_usd
 from simkit.importer import import_robot
-from tests.usd_stages import arm
 
 pytest.importorskip("pxr")
 
