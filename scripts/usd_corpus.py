@@ -99,8 +99,16 @@ def _run(args: list[str], timeout: float, env=None) -> tuple[int, str]:
 def one(path: Path, root: Path, work: Path, args) -> dict:
     """Convert, import, compare (and build) one robot file; its row."""
     rel = path.relative_to(root).as_posix()
-    slug = re.sub(r"[^A-Za-z0-9]+", "_", rel).strip("_").lower()
     row = {"file": rel, "step": "convert", "ok": False, "why": ""}
+    done = _steps(path, rel, work, row, args)
+    # no machine's paths in the table: the corpus and work folders by name
+    done["why"] = done["why"].replace(str(root), root.name).replace(str(work), "OUT")
+    return done
+
+
+def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
+    """The steps of `one`, filling `row`."""
+    slug = re.sub(r"[^A-Za-z0-9]+", "_", rel).strip("_").lower()
     conv = work / slug / "usd"
     tool = venv_dir(args) / "bin" / ("mujoco_usd_converter" if args.mjcf else "urdf_usd_converter")
     code, text = _run([str(tool), str(path), str(conv)], args.timeout)

@@ -98,3 +98,15 @@ def test_closed_loop_dropped(tmp_path, excluded: bool) -> None:
     assert "zloop" not in _by_name(spec["joints"])
     assert "joints.zloop" in {d["what"] for d in spec["source_differences"]}
     assert any("zloop" in line and "closed loop" in line for line in done.lines)
+
+
+def test_two_joints_one_pair(tmp_path) -> None:
+    """Two joints between one pair of bodies (a body with two degrees of freedom): a chain
+    through an added massless link, in path order, listed as added."""
+    path = arm(tmp_path / "arm.usda", chain=True)
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    joints = _by_name(spec["joints"])
+    assert (joints["shoulder"]["parent"], joints["shoulder"]["child"]) == ("base", "shoulder_link")
+    assert (joints["twist"]["parent"], joints["twist"]["child"]) == ("shoulder_link", "upper")
+    assert joints["twist"]["axis"] == [1.0, 0.0, 0.0]
+    assert "links.shoulder_link" in {d["what"] for d in spec["source_differences"]}

@@ -29,7 +29,7 @@ def _urdf(spec: dict) -> str:
             f' ixz="{i.get("ixz", 0)!r}" iyy="{i["iyy"]!r}" iyz="{i.get("iyz", 0)!r}"'
             f' izz="{i["izz"]!r}"/></inertial></link>',
         ]
-    out.append('<link name="world"/>')
+    out += ['<link name="world"/>', *(f'<link name="{n}"/>' for n in _added(spec))]
     for j in spec["joints"]:
         limit = ""
         if "lower" in j:
@@ -45,14 +45,21 @@ def _urdf(spec: dict) -> str:
     return "\n".join([*out, "</robot>"])
 
 
+def _added(spec: dict) -> list[str]:
+    """Links the joints name that the spec's links do not hold (massless chain links)."""
+    named = {link["name"] for link in spec["links"]} | {"world"}
+    return sorted({j["child"] for j in spec["joints"]} - named)
+
+
 def _v(values) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-@pytest.fixture(scope="module")
-def imported(tmp_path_factory):
+@pytest.fixture(scope="module", params=[False, True], ids=["arm", "two_dof_body"])
+def imported(tmp_path_factory, request):
+    """The arm imported; with two joints between one pair of bodies (a chain)."""
     folder = tmp_path_factory.mktemp("usd_source")
-    done = import_robot(arm(folder / "arm.usda"), folder / "out")
+    done = import_robot(arm(folder / "arm.usda", chain=request.param), folder / "out")
     return done.spec_path, yaml.safe_load(done.spec_path.read_text())
 
 

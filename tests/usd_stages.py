@@ -13,13 +13,16 @@ def arm(
     articulated: bool = True,
     variant: bool = False,
     loop: bool | None = None,
+    chain: bool = False,
 ) -> Path:
     """A fixed-base two-link arm per robot: `base` (box, MassAPI 2 kg) bolted to the world,
     `upper` on a revolute joint about Z (-90..45 degrees), `slider` on a prismatic joint
     along X (0..0.2 m, stage units); with `variant`, a `Physics` variant set whose
     `heavy` variant sets `upper`'s mass to 3 kg (default `light`: 1 kg); with `loop` a
     fixed joint `loop` from `base` to `slider` closes a loop (True: marked
-    excludeFromArticulation; False: not marked, so `slider` has two parent joints)."""
+    excludeFromArticulation; False: not marked, so `slider` has two parent joints); with
+    `chain` a second revolute joint `twist` (about X, at the shoulder) joins `base` and
+    `upper` too: a body with two degrees of freedom, as MJCF writes it."""
     from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
     stage = Usd.Stage.CreateNew(str(path))
@@ -47,6 +50,12 @@ def arm(
             cube.CreateDisplayColorAttr([Gf.Vec3f(0.2, 0.4, 0.6)])
             bodies[name] = xf.GetPath()
         _joints(stage, f"/arm{r}", bodies, unit)
+        if chain:
+            twist = UsdPhysics.RevoluteJoint.Define(stage, f"/arm{r}/twist")
+            twist.CreateBody0Rel().SetTargets([bodies["base"]])
+            twist.CreateBody1Rel().SetTargets([bodies["upper"]])
+            twist.CreateLocalPos0Attr(Gf.Vec3f(0, 0, 0.5 * unit))
+            twist.CreateAxisAttr("X")
         if loop is not None:
             closing = UsdPhysics.FixedJoint.Define(stage, f"/arm{r}/zloop")
             closing.CreateBody0Rel().SetTargets([bodies["base"]])

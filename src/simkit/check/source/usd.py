@@ -272,6 +272,8 @@ class Robot:
     root: str = ""
     #: (joint name, flipped) in breadth-first order from the root
     tree: list[tuple[str, bool]] = field(default_factory=list)
+    #: tree joint -> the further joints between the same two bodies (a multi-DOF body)
+    chains: dict[str, list[str]] = field(default_factory=dict)
 
     def poses(self, q: dict[str, float]) -> dict[str, np.ndarray]:
         """Each body's pose relative to the root body at joint values `q` (rad or m; a
@@ -284,6 +286,9 @@ class Robot:
                 out[j.body0] = out[j.body1] @ j.pose1 @ np.linalg.inv(motion) @ _inv(j.pose0)
             else:
                 out[j.body1] = out[j.body0] @ j.pose0 @ motion @ _inv(j.pose1)
+                for more in self.chains.get(name, []):
+                    k = self.joints[more]
+                    out[j.body1] = out[j.body1] @ k.pose1 @ _motion(k, more, q) @ _inv(k.pose1)
         return out
 
 
@@ -436,11 +441,17 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
     bodies = set(names.values())
     roots = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.ArticulationRootAPI)]
     root = names.get(str(roots[0].GetPath())) if roots else None
-    inner, claimed = {}, set()
+    inner, claimed = {}, {}
     for n, j in sorted(robot.joints.items(), key=lambda item: item[1].path):
-        if j.body0 in bodies and j.body1 in bodies and j.body1 not in claimed:
-            claimed.add(j.body1)  # a body's second parent joint closes a loop: not in the tree
+        if not (j.body0 in bodies and j.body1 in bodies):
+            continue
+        first = claimed.get(j.body1)
+        if first is None:
+            claimed[j.body1] = n
             inner[n] = j
+        elif robot.joints[first].body0 == j.body0:  # one more DOF between the same bodies
+            robot.chains.setdefault(first, []).append(n)
+        # else: a body's second parent joint closes a loop: not in the tree
     world = [
         (n, j)
         for n, j in sorted(robot.joints.items())
@@ -467,7 +478,8 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
             if other in seen:
                 continue
             seen.add(other)
-            robot.bodies[other].frame = _moved(j.pose0 if flip else j.pose1)
+            last = robot.joints[robot.chains[name][-1]] if name in robot.chains and not flip else j
+            robot.bodies[other].frame = _moved(j.pose0 if flip else last.pose1)
             robot.tree.append((name, flip))
             todo.append(other)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.importer.formats.usd import poses
+from simkit.importer.formats.usd import poses, shapes
 
 #: kg/m^3 where neither the body nor its colliders author a density (UsdPhysics' default)
 DEFAULT_DENSITY = 1000.0
@@ -24,6 +24,7 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
     mass nor a collider (the translation estimates it from its visual, and says so)."""
     from pxr import UsdPhysics
 
+    owned = _owned(link)
     api = UsdPhysics.MassAPI(prim) if prim.HasAPI(UsdPhysics.MassAPI) else None
     kg = _value(api, "GetMassAttr", 0.0) * ctx.units.kilograms
     com = _value(api, "GetCenterOfMassAttr", None)
@@ -34,7 +35,7 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
     if kg <= 0 or com is None or diagonal is None:
         density = _value(api, "GetDensityAttr", 0.0) or DEFAULT_DENSITY
         density *= ctx.units.kilograms / ctx.units.meters**3
-        solid = _solid(link, density)
+        solid = _solid(owned, density)
         if solid is None and kg <= 0:
             return None
     if kg <= 0:
@@ -78,47 +79,84 @@ def _value(api, getter: str, default):
     return float(value) if isinstance(default, float) else value
 
 
-def _solid(link, density: float) -> tuple[float, np.ndarray, np.ndarray] | None:
-    """(mass kg, CoM m, inertia about the CoM kg m^2) of the link's `<collision>` shapes
-    (link frame) at `density`; None without a collider of positive volume."""
-    import trimesh
-
-    pieces = []
+def _owned(link) -> dict:
+    """Each `<collision>` -> (its shape's MassAPI density kg/m^3, mass kg; 0: not given),
+    the attributes shapes.py recorded them in taken off the element."""
+    out = {}
     for collision in link.findall("collision"):
-        mesh = _mesh(collision.find("geometry")[0])
-        if mesh is None:
+        density = float(collision.attrib.pop(shapes.DENSITY, 0) or 0)
+        out[collision] = (density, float(collision.attrib.pop(shapes.MASS, 0) or 0))
+    return out
+
+
+def _solid(owned: dict, density: float) -> tuple[float, np.ndarray, np.ndarray] | None:
+    """(mass kg, CoM m, inertia about the CoM kg m^2) of the link's `<collision>` shapes
+    (link frame; `owned`: _owned's), each at its own MassAPI density or mass, else
+    `density`; primitives exactly, a mesh as its closed solid (else its convex hull). None
+    without a collider of positive volume."""
+    pieces = []
+    for collision, (own_density, own_mass) in owned.items():
+        own_density = own_density or density
+        piece = _piece(collision.find("geometry")[0])
+        if piece is None or piece[0] <= 0:
             continue
-        xyz = [float(v) for v in collision.find("origin").get("xyz").split()]
-        rpy = [float(v) for v in collision.find("origin").get("rpy").split()]
-        mesh.apply_transform(trimesh.transformations.compose_matrix(angles=rpy, translate=xyz))
-        pieces.append(mesh)
-    if not pieces:
+        volume, centre, unit = piece
+        mass = own_mass or own_density * volume
+        origin = collision.find("origin")
+        xyz = np.array([float(v) for v in origin.get("xyz").split()])
+        turn = _rpy_matrix([float(v) for v in origin.get("rpy").split()])
+        pieces.append((mass, turn @ centre + xyz, turn @ (unit * mass / volume) @ turn.T))
+    total = sum(p[0] for p in pieces)
+    if total <= 0:
         return None
-    solid = trimesh.util.concatenate(pieces)
-    solid.density = density
-    if solid.volume <= 0:
-        return None
-    return float(solid.mass), np.asarray(solid.center_mass), np.asarray(solid.moment_inertia)
+    com = sum(p[0] * p[1] for p in pieces) / total
+    tensor = np.zeros((3, 3))
+    for mass, centre, inertia in pieces:
+        d = centre - com
+        tensor += inertia + mass * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
+    return float(total), com, tensor
 
 
-def _mesh(shape):
-    """A trimesh solid of one URDF geometry element (closed; a mesh's convex hull)."""
-    import trimesh
+def _rpy_matrix(rpy) -> np.ndarray:
+    r, p, y = rpy
+    rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
+    ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
+    rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def _piece(shape) -> tuple[float, np.ndarray, np.ndarray] | None:
+    """(volume m^3, centroid m, inertia about the centroid at unit density kg m^2) of one
+    URDF geometry in its own frame; None for a shape without volume."""
+    import math
 
     if shape.tag == "box":
-        return trimesh.creation.box([float(v) for v in shape.get("size").split()])
+        a, b, c = (float(v) for v in shape.get("size").split())
+        v = a * b * c
+        return v, np.zeros(3), v / 12.0 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
     if shape.tag == "sphere":
-        return trimesh.creation.icosphere(4, float(shape.get("radius")))
+        r = float(shape.get("radius"))
+        v = 4.0 / 3.0 * math.pi * r**3
+        return v, np.zeros(3), np.eye(3) * 0.4 * v * r * r
     if shape.tag in ("cylinder", "capsule"):
-        make = trimesh.creation.cylinder if shape.tag == "cylinder" else trimesh.creation.capsule
-        kwargs = {"radius": float(shape.get("radius"))}
-        kwargs["height"] = float(shape.get("length"))
-        return (
-            make(**kwargs, sections=64)
-            if shape.tag == "cylinder"
-            else make(**kwargs, count=[32, 32])
-        )
+        r, h = float(shape.get("radius")), float(shape.get("length"))
+        vc = math.pi * r * r * h
+        side, axial = vc * (3 * r * r + h * h) / 12.0, vc * r * r / 2.0
+        v = vc
+        if shape.tag == "capsule":  # two hemispheres at the ends
+            vs = 4.0 / 3.0 * math.pi * r**3
+            side += vs * (0.4 * r * r + h * h / 4.0 + 3.0 * h * r / 8.0)
+            axial += vs * 0.4 * r * r
+            v += vs
+        return v, np.zeros(3), np.diag([side, side, axial])
     if shape.tag == "mesh":
+        import trimesh
+
         mesh = trimesh.load_mesh(shape.get("filename"))
-        return mesh if mesh.is_watertight and mesh.volume > 0 else mesh.convex_hull
+        if not (mesh.is_watertight and mesh.volume > 0):
+            mesh = mesh.convex_hull
+        if mesh.volume <= 0:
+            return None
+        mesh.density = 1.0
+        return float(mesh.volume), np.asarray(mesh.center_mass), np.asarray(mesh.moment_inertia)
     return None

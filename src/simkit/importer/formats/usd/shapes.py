@@ -20,6 +20,9 @@ import numpy as np
 from simkit.importer.formats.usd import poses
 
 SHAPES = ("Cube", "Sphere", "Capsule", "Cylinder", "Mesh")
+#: attributes on a `<collision>` holding its shape's MassAPI density and mass until mass.py
+#: takes them off (UsdPhysics: a collider's own MassAPI sets its share of the body's mass)
+DENSITY, MASS = "usd-density", "usd-mass"
 
 
 def prims_of(body, bodies: set[str]):
@@ -53,7 +56,9 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
             and imageable.ComputePurpose() in (UsdGeom.Tokens.default_, UsdGeom.Tokens.render)
         )
         if collides:
-            _element(link, "collision", prim, full, ctx)
+            element = _element(link, "collision", prim, full, ctx)
+            if element is not None and prim.HasAPI(UsdPhysics.MassAPI):
+                _own_mass(element, UsdPhysics.MassAPI(prim), ctx.units)
             if prim.HasAPI(UsdPhysics.MeshCollisionAPI):
                 how = UsdPhysics.MeshCollisionAPI(prim).GetApproximationAttr().Get()
                 notes.append(str(how or "none"))
@@ -62,6 +67,16 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
             if element is not None:
                 _colour(element, prim)
     return notes
+
+
+def _own_mass(element, api, units) -> None:
+    """Record a collider's MassAPI density and mass (stage units to kg/m^3 and kg)."""
+    density, mass = api.GetDensityAttr(), api.GetMassAttr()
+    if density and density.HasAuthoredValue() and float(density.Get()) > 0:
+        value = float(density.Get()) * units.kilograms / units.meters**3
+        element.set(DENSITY, repr(value))
+    if mass and mass.HasAuthoredValue() and float(mass.Get()) > 0:
+        element.set(MASS, repr(float(mass.Get()) * units.kilograms))
 
 
 def _f32(values) -> np.ndarray:

@@ -60,6 +60,8 @@ class Context:
     names: dict[str, str] = field(default_factory=dict)
     listed: list[tuple[str, str]] = field(default_factory=list)
     dropped: list[tuple[object, str]] = field(default_factory=list)
+    #: massless links added between the joints of one pair of bodies (_chain)
+    added: list[str] = field(default_factory=list)
     #: id(joint) -> its frame's turn in the child's body axes (the axis is turned by it)
     turns: dict[int, np.ndarray] = field(default_factory=dict)
 
@@ -112,9 +114,10 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     for body in art.bodies:
         if body in frames:
             _link(robot, body, frames[body], ctx)
+    for name in ctx.added:
+        etree.SubElement(robot, "link", name=name)
     for joint, parent, child, flip, origin in order:
-        ends_ = (ctx.names[parent], ctx.names[child])
-        _joint(robot, joint, joint_names, ends_, origin, ctx, flip)
+        _joint(robot, joint, joint_names, (parent, child), origin, ctx, flip)
     for body in art.bodies:
         if body in frames:
             _frames(robot, body, frames[body], ctx)
@@ -141,17 +144,19 @@ def _walk(art: Articulation, root: str, ctx: Context):
     bodies = set(art.bodies)
     frames: dict[str, np.ndarray] = {}
     base, loops, order = None, [], []
-    tree_joints, claimed = [], set()
+    tree_joints, claimed, extras = [], {}, {}
     for joint in art.joints:
         a, b = ends(joint)
         excluded = bool(UsdPhysics.Joint(joint).GetExcludeFromArticulationAttr().Get())
         world = (a not in bodies) != (b not in bodies)
         if world and base is None and root in (a, b) and not excluded:
             base = joint
+        elif not (world or excluded) and b in claimed and ends(claimed[b])[0] == a:
+            extras.setdefault(id(claimed[b]), []).append(joint)  # one more DOF, the same pair
         elif world or excluded or b in claimed:
             loops.append(joint)  # a body's second parent joint (path order) closes a loop
         else:
-            claimed.add(b)
+            claimed[b] = joint
             tree_joints.append(joint)
     frames[root] = np.eye(4)
     if base is not None:
@@ -173,10 +178,48 @@ def _walk(art: Articulation, root: str, ctx: Context):
             origin = poses.inv(frames[body]) @ local_pose(joint, near, ctx) @ _turn_back(there)
             frames[other] = _at(there)
             ctx.turns[id(joint)] = there[:3, :3]
-            order.append((joint, body, other, flip, origin))
+            chain = [] if flip else extras.pop(id(joint), [])
+            loops += extras.pop(id(joint), [])  # a turned-round pair's further joints
+            order += _chain(joint, chain, ctx.names[body], ctx.names[other], flip, origin, ctx)
+            if chain:
+                frames[other] = _at(local_pose(chain[-1], 1, ctx))
             todo.append(other)
     loops += [j for j in tree_joints if id(j) not in used]
+    loops += [j for rest in extras.values() for j in rest]
     return frames, order, loops, base
+
+
+def _chain(first, rest: list, parent: str, child: str, flip: bool, origin, ctx: Context):
+    """Order entries (joint, parent link, child link, flipped, origin) of the joints between
+    one pair of bodies: one joint, or several (a body with several degrees of freedom, as
+    MJCF writes it and mujoco-usd-converter keeps it) made a chain through added massless
+    links `JOINT_link`, each joint turning about its own frame on body1, in path order."""
+    if not rest:
+        return [(first, parent, child, flip, origin)]
+    joints = [first, *rest]
+    out, at = [], parent
+    for k, joint in enumerate(joints):
+        pose = local_pose(joint, 1, ctx)
+        if k:
+            ctx.turns[id(joint)] = pose[:3, :3]
+            before = local_pose(joints[k - 1], 1, ctx)[:3, 3]
+            origin = poses.make(np.eye(3), pose[:3, 3] - before)
+        to = child if k == len(joints) - 1 else _added(f"{joint.GetName()}_link", ctx)
+        out.append((joint, at, to, False, origin))
+        at = to
+    return out
+
+
+def _added(want: str, ctx: Context) -> str:
+    """A new massless link's name, unique among the body names and those added."""
+    taken = set(ctx.names.values()) | set(ctx.added)
+    name, n = want, 1
+    while name in taken:
+        name, n = f"{want}_{n}", n + 1
+    ctx.added.append(name)
+    why = "added: a link between two joints of one pair of USD bodies"
+    ctx.listed.append((f"links.{name}", why))
+    return name
 
 
 def _frames(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
