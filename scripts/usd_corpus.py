@@ -373,6 +373,13 @@ def compare_mjcf(path: Path, spec: dict) -> list[str]:
     kit = Kit(spec)
     mine = [b for b in range(1, model.nbody) if model.body_rootid[b] == top]
     name = {b: model.body(b).name or f"body{b}" for b in mine}
+    for b in mine:  # an unnamed body: the kit's link its last joint moves
+        count = int(model.body_jntnum[b])
+        if not model.body(b).name and count:
+            last = int(model.body_jntadr[b]) + count - 1
+            joint = kit.joints.get(kit.name("joints", model.joint(last).name or f"jnt{last}"))
+            if joint is not None:
+                kit.renames[f"links.{name[b]}"] = joint["child"]
     bodies = {name[b]: (float(model.body_mass[b]), None) for b in mine if model.body_mass[b] > 0}
     joints = {}
     for j in range(model.njnt):
