@@ -226,8 +226,15 @@ class Kit:
         self.joints = {j["name"]: j for j in spec["joints"]}
 
     def name(self, kind: str, original: str) -> str:
-        prim = identifier(original)
-        return self.renames.get(f"{kind}.{prim}", prim)
+        """The kit's name of an original element: as the import renamed it, else its own
+        (a converter keeps it as the prim's displayName), else as a USD identifier."""
+        table = self.links if kind == "links" else self.joints
+        for candidate in (original, identifier(original)):
+            if f"{kind}.{candidate}" in self.renames:
+                return self.renames[f"{kind}.{candidate}"]
+            if candidate in table:
+                return candidate
+        return identifier(original)
 
     def com_world(self, poses: dict, link: str) -> tuple[np.ndarray, np.ndarray]:
         """(CoM, inertia tensor) of a spec link in the root frame."""

@@ -110,3 +110,18 @@ def test_two_joints_one_pair(tmp_path) -> None:
     assert (joints["twist"]["parent"], joints["twist"]["child"]) == ("shoulder_link", "upper")
     assert joints["twist"]["axis"] == [1.0, 0.0, 0.0]
     assert "links.shoulder_link" in {d["what"] for d in spec["source_differences"]}
+
+
+def test_display_names(tmp_path) -> None:
+    """A prim's displayName (the source's own name, kept there by converters when it is no
+    USD identifier) names its link or joint."""
+    from pxr import Usd
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    stage.GetPrimAtPath("/arm0/shoulder").SetDisplayName("hip_pitch")
+    stage.GetPrimAtPath("/arm0/upper").SetDisplayName("thigh")
+    stage.GetRootLayer().Save()
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    joints = _by_name(spec["joints"])
+    assert joints["hip_pitch"]["child"] == "thigh" and "thigh" in _by_name(spec["links"])

@@ -336,11 +336,13 @@ def _quat(w: float, x: float, y: float, z: float) -> np.ndarray:
     ])  # fmt: skip
 
 
-def _unique(paths) -> dict[str, str]:
-    """Prim path -> its name, made unique in path order, as the import names them."""
+def _unique(stage, paths) -> dict[str, str]:
+    """Prim path -> its name (its displayName where authored), made unique in path order, as
+    the import names them."""
     out, taken = {}, set()
     for path in sorted(paths):
-        want = path.rsplit("/", 1)[-1] or "root"
+        prim = stage.GetPrimAtPath(path)
+        want = (prim.GetDisplayName() if prim else "") or path.rsplit("/", 1)[-1] or "root"
         name, n = want, 1
         while name in taken:
             name, n = f"{want}_{n}", n + 1
@@ -371,13 +373,13 @@ def source_robot(path: Path, variant: str | None) -> Robot:
         UsdPhysics.ObjectType.SphericalJoint: "spherical",
     }
     body_paths = [str(p) for p in parsed.get(UsdPhysics.ObjectType.RigidBody, ([], []))[0]]
-    names = _unique(body_paths)
+    names = _unique(stage, body_paths)
     joints, joint_paths = [], []
     for kind, label in kinds.items():
         for at, desc in zip(*parsed.get(kind, ([], [])), strict=True):
             joints.append((str(at), label, desc))
             joint_paths.append(str(at))
-    joint_names = _unique(joint_paths)
+    joint_names = _unique(stage, joint_paths)
     robot = Robot()
     for at, label, d in sorted(joints):
         b0, b1 = str(d.body0), str(d.body1)

@@ -66,11 +66,15 @@ class Context:
     turns: dict[int, np.ndarray] = field(default_factory=dict)
 
 
-def unique_names(paths: list[str]) -> dict[str, str]:
-    """Prim path -> its name, made unique in path order (`NAME_1`, `NAME_2`...)."""
+def unique_names(stage, paths: list[str]) -> dict[str, str]:
+    """Prim path -> its name: its `displayName` where authored (the source's own name, which
+    converters keep there when it is no USD identifier, `0` for a prim `tn__0_`), else the
+    prim's; made unique in path order (`NAME_1`, `NAME_2`...)."""
     out, taken = {}, set()
     for path in sorted(paths):
-        want = path.rsplit("/", 1)[-1] or "root"
+        prim = stage.GetPrimAtPath(path)
+        shown = prim.GetDisplayName() if prim else ""
+        want = shown or path.rsplit("/", 1)[-1] or "root"
         name, n = want, 1
         while name in taken:
             name, n = f"{want}_{n}", n + 1
@@ -101,8 +105,8 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     from pxr import UsdGeom
 
     ctx = Context(art, poses.Units.of(art.stage), UsdGeom.XformCache(), scratch)
-    ctx.names = unique_names(art.bodies)
-    joint_names = unique_names([str(j.GetPath()) for j in art.joints])
+    ctx.names = unique_names(art.stage, art.bodies)
+    joint_names = unique_names(art.stage, [str(j.GetPath()) for j in art.joints])
     robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
     robot.sourceline = 0
     root = str(art.root_prim.GetPath())
