@@ -125,3 +125,21 @@ def test_display_names(tmp_path) -> None:
     spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
     joints = _by_name(spec["joints"])
     assert joints["hip_pitch"]["child"] == "thigh" and "thigh" in _by_name(spec["links"])
+
+
+def test_flat_mesh_left_out(tmp_path) -> None:
+    """A visual mesh that encloses no volume (a sheet) is left out and listed, not a build
+    failure."""
+    from pxr import Gf, Usd, UsdGeom
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    sheet = UsdGeom.Mesh.Define(stage, "/arm0/upper/sheet")
+    sheet.CreatePointsAttr(
+        [Gf.Vec3f(0, 0, 0), Gf.Vec3f(1, 0, 0), Gf.Vec3f(1, 1, 0), Gf.Vec3f(0, 1, 0)]
+    )
+    sheet.CreateFaceVertexCountsAttr([4])
+    sheet.CreateFaceVertexIndicesAttr([0, 1, 2, 3])
+    stage.GetRootLayer().Save()
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    assert "links.upper.visual.sheet" in {d["what"] for d in spec["source_differences"]}

@@ -86,7 +86,7 @@ def _f32(values) -> np.ndarray:
 
 def _element(link, tag: str, prim, full: np.ndarray, ctx):
     """One `<collision>` or `<visual>` of a shape prim (transform `full` in the link
-    frame, scale included); None for an empty mesh."""
+    frame, scale included); None for an empty or flat mesh (listed)."""
     from lxml import etree
 
     kind = prim.GetTypeName()
@@ -96,6 +96,8 @@ def _element(link, tag: str, prim, full: np.ndarray, ctx):
     if kind == "Mesh":
         path = _stl(prim, full, ctx.scratch)
         if path is None:
+            what = f"links.{link.get('name')}.{tag}.{prim.GetName()}"
+            ctx.listed.append((what, "a mesh with no faces or no volume (flat): left out"))
             return None
         pose = np.eye(4)
         etree.SubElement(geometry, "mesh", filename=str(path))
@@ -160,13 +162,25 @@ def _stl(prim, full: np.ndarray, scratch: Path) -> Path | None:
         faces += [(flat[at], flat[at + k], flat[at + k + 1]) for k in range(1, int(count) - 1)]
         at += int(count)
     faces = [f for f in faces if max(f) < len(vertices)]
-    if not faces:
+    if not faces or is_flat(vertices):
         return None
     mesh = trimesh.Trimesh(vertices, np.asarray(faces), process=False)
     data = mesh.export(file_type="stl")
     path = scratch / f"{prim.GetName()}_{hashlib.sha256(data).hexdigest()[:12]}.stl"
     path.write_bytes(data)
     return path
+
+
+def is_flat(points: np.ndarray) -> bool:
+    """Whether a mesh encloses no volume, even as its convex hull (a decal, a sheet): a kit's
+    solid must be closed, so it is left out (listed)."""
+    import manifold3d as mf
+
+    if len(points) < 4:
+        return True
+    hull = mf.Manifold.hull_points(np.asarray(points, dtype=np.float32))
+    extent = float(np.ptp(points, axis=0).max())
+    return hull.is_empty() or hull.volume() <= 1e-9 * extent**3
 
 
 def _colour(element, prim) -> None:
