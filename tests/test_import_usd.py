@@ -143,3 +143,17 @@ def test_flat_mesh_left_out(tmp_path) -> None:
     stage.GetRootLayer().Save()
     spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
     assert "links.upper.visual.sheet" in {d["what"] for d in spec["source_differences"]}
+
+
+def test_loose_body_noted(tmp_path) -> None:
+    """A rigid body joined to nothing (a scene's object) is not imported: one line says so."""
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    ball = UsdGeom.Xform.Define(stage, "/ball")
+    UsdPhysics.RigidBodyAPI.Apply(ball.GetPrim())
+    stage.GetRootLayer().Save()
+    done = import_robot(path, tmp_path / "out")
+    assert any("1 rigid bodies not joined to the robot (first /ball)" in x for x in done.lines)
+    assert "ball" not in _by_name(yaml.safe_load(done.spec_path.read_text())["links"])

@@ -82,16 +82,21 @@ def articulation(path: Path, stage) -> Articulation:
     graph = _graph(linking, bodies)
     root = _root_body(roots[0] if roots else None, graph, bodies, linking)
     found = _connected(root, graph)
-    if len({str(p.GetPath()) for p in roots}) == 0:
+    if not roots:  # without a root, jointed bodies apart from the robot are another robot
         rest = bodies - found - {b for b in bodies if not graph.get(b)}
         if rest:
             raise SpecError(
                 str(path), None, f"prim {sorted(rest)[0]}",
                 "several robots (jointed bodies not connected to each other): import one per file",
             )  # fmt: skip
+    apart = bodies - found
+    if apart:
+        notes.append(
+            f"not imported: {len(apart)} rigid bodies not joined to the robot (first "
+            f"{sorted(apart)[0]}): objects of the scene, not the robot"
+        )
     touching = [j for j in linking if {t for t in _ends(j) if t} & found]
-    out = Articulation(stage, stage.GetPrimAtPath(root), sorted(found), touching, notes=notes)
-    return out
+    return Articulation(stage, stage.GetPrimAtPath(root), sorted(found), touching, notes=notes)
 
 
 def _ends(joint) -> tuple[str | None, str | None]:
@@ -107,7 +112,7 @@ def _ends(joint) -> tuple[str | None, str | None]:
 
 
 def ends(joint) -> tuple[str | None, str | None]:
-    """(body0, body1) of a joint prim (public for the tree)."""
+    """(body0, body1) prim paths of a joint prim (None: not set)."""
     return _ends(joint)
 
 
