@@ -157,3 +157,14 @@ def test_loose_body_noted(tmp_path) -> None:
     done = import_robot(path, tmp_path / "out")
     assert any("1 rigid bodies not joined to the robot (first /ball)" in x for x in done.lines)
     assert "ball" not in _by_name(yaml.safe_load(done.spec_path.read_text())["links"])
+
+
+def test_world_joints_chain(tmp_path) -> None:
+    """Several joints holding the root body to the world (a base on slides and a hinge, as
+    MJCF writes a mobile base) are a chain from the world link, in path order."""
+    path = arm(tmp_path / "arm.usda", rail=True)
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    joints = _by_name(spec["joints"])
+    assert (joints["rail"]["parent"], joints["rail"]["child"]) == ("world", "rail_link")
+    assert (joints["yaw"]["parent"], joints["yaw"]["child"]) == ("rail_link", "base")
+    assert joints["rail"]["type"] == "prismatic" and joints["yaw"]["type"] == "continuous"

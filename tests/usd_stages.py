@@ -14,6 +14,7 @@ def arm(
     variant: bool = False,
     loop: bool | None = None,
     chain: bool = False,
+    rail: bool = False,
 ) -> Path:
     """A fixed-base two-link arm per robot: `base` (box, MassAPI 2 kg) bolted to the world,
     `upper` on a revolute joint about Z (-90..45 degrees), `slider` on a prismatic joint
@@ -22,7 +23,9 @@ def arm(
     fixed joint `loop` from `base` to `slider` closes a loop (True: marked
     excludeFromArticulation; False: not marked, so `slider` has two parent joints); with
     `chain` a second revolute joint `twist` (about X, at the shoulder) joins `base` and
-    `upper` too: a body with two degrees of freedom, as MJCF writes it."""
+    `upper` too: a body with two degrees of freedom, as MJCF writes it; with `rail`, two
+    joints without body0 hold `base` to the world in place of the fixed one: `rail`
+    (prismatic along X), then `yaw` (revolute about Z)."""
     from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
     stage = Usd.Stage.CreateNew(str(path))
@@ -50,6 +53,13 @@ def arm(
             cube.CreateDisplayColorAttr([Gf.Vec3f(0.2, 0.4, 0.6)])
             bodies[name] = xf.GetPath()
         _joints(stage, f"/arm{r}", bodies, unit)
+        if rail:
+            stage.RemovePrim(f"/arm{r}/world_joint")
+            for name, kind, axis in (("rail", UsdPhysics.PrismaticJoint, "X"),
+                                     ("yaw", UsdPhysics.RevoluteJoint, "Z")):  # fmt: skip
+                joint = kind.Define(stage, f"/arm{r}/{name}")
+                joint.CreateBody1Rel().SetTargets([bodies["base"]])
+                joint.CreateAxisAttr(axis)
         if chain:
             twist = UsdPhysics.RevoluteJoint.Define(stage, f"/arm{r}/twist")
             twist.CreateBody0Rel().SetTargets([bodies["base"]])

@@ -465,10 +465,14 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
     if root is None:
         children = {j.body1 for j in inner.values()}
         root = next(n for n in sorted(bodies) if n not in children and _touches(n, inner))
-    for _, j in world:
-        if root in (j.body0, j.body1) and (j.body0 in bodies) != (j.body1 in bodies):
-            robot.bodies[root].frame = _moved(j.pose1 if j.body1 == root else j.pose0)
-            break
+    held = [j for _, j in sorted(world, key=lambda item: item[1].path) if root == j.body1]
+    if held:  # the last of the joints holding the root to the world (a chain), as imported
+        robot.bodies[root].frame = _moved(held[-1].pose1)
+    else:
+        for _, j in world:
+            if root == j.body0:
+                robot.bodies[root].frame = _moved(j.pose0)
+                break
     robot.root, todo, seen = root, [root], {root}
     while todo:
         at = todo.pop(0)

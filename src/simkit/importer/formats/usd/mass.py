@@ -38,14 +38,10 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
         solid = _solid(owned, density)
         if solid is None and kg <= 0:
             return None
+    key = f"links.{link.get('name')}"
     if kg <= 0:
         kg = solid[0]
-        ctx.listed.append(
-            (
-                f"links.{link.get('name')}.mass",
-                "no MassAPI mass: the colliders' solid at its density",
-            )
-        )
+        ctx.listed.append((f"{key}.mass", "no MassAPI mass: the colliders' solid at its density"))
     given = diagonal is not None and np.any(np.asarray(diagonal) > 0)
     if given and kg > 0 and (com is None or not np.all(np.asarray(com) > UNSET)):
         com = (0.0, 0.0, 0.0)  # inertia given about a CoM left unwritten: the body origin
@@ -55,10 +51,12 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
         centre = centre + to_link[:3, 3]
     else:
         centre = solid[1] if solid is not None else np.zeros(3)
+        ctx.listed.append((f"{key}.com", "no MassAPI centerOfMass: the colliders' solid's"))
     if diagonal is not None and np.any(np.asarray(diagonal) > 0):
         moments = np.asarray(diagonal, float) * ctx.units.kilograms * ctx.units.meters**2
         turn = poses.quat_matrix(axes) if axes is not None else np.eye(3)
         return kg, centre, to_link[:3, :3] @ turn, moments
+    ctx.listed.append((f"{key}.inertia", "no MassAPI diagonalInertia: the colliders' solid's"))
     if solid is None:
         return kg, centre, np.eye(3), np.zeros(3)
     tensor = solid[2] * (kg / solid[0])

@@ -110,11 +110,12 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
     robot.sourceline = 0
     root = str(art.root_prim.GetPath())
-    frames, order, loops, base = _walk(art, root, ctx)
+    frames, order, loops, (base, world) = _walk(art, root, ctx)
     floating = base is None
     if base is not None:
         etree.SubElement(robot, "link", name=WORLD).sourceline = 0
-        _joint(robot, base, joint_names, (WORLD, ctx.names[root]), _world_origin(base, ctx), ctx)
+        origin = _world_origin(base, ctx)
+        order = [*_chain(base, world, WORLD, ctx.names[root], False, origin, ctx), *order]
     for body in art.bodies:
         if body in frames:
             _link(robot, body, frames[body], ctx)
@@ -155,6 +156,8 @@ def _walk(art: Articulation, root: str, ctx: Context):
         world = (a not in bodies) != (b not in bodies)
         if world and base is None and root in (a, b) and not excluded:
             base = joint
+        elif world and base is not None and b == root == ends(base)[1] and not excluded:
+            extras.setdefault(id(base), []).append(joint)  # more DOF between world and root
         elif not (world or excluded) and b in claimed and ends(claimed[b])[0] == a:
             extras.setdefault(id(claimed[b]), []).append(joint)  # one more DOF, the same pair
         elif world or excluded or b in claimed:
@@ -165,7 +168,8 @@ def _walk(art: Articulation, root: str, ctx: Context):
     frames[root] = np.eye(4)
     if base is not None:
         end = 1 if ends(base)[1] == root else 0
-        frames[root] = _at(local_pose(base, end, ctx))
+        last = (extras.get(id(base)) or [base])[-1]
+        frames[root] = _at(local_pose(last, end, ctx))
     todo, used = [root], set()
     while todo:
         body = todo.pop(0)
@@ -189,8 +193,9 @@ def _walk(art: Articulation, root: str, ctx: Context):
                 frames[other] = _at(local_pose(chain[-1], 1, ctx))
             todo.append(other)
     loops += [j for j in tree_joints if id(j) not in used]
+    world = extras.pop(id(base), []) if base is not None else []
     loops += [j for rest in extras.values() for j in rest]
-    return frames, order, loops, base
+    return frames, order, loops, (base, world)
 
 
 def _chain(first, rest: list, parent: str, child: str, flip: bool, origin, ctx: Context):
