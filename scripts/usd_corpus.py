@@ -102,7 +102,8 @@ def one(path: Path, root: Path, work: Path, args) -> dict:
     row = {"file": rel, "step": "convert", "ok": False, "why": ""}
     done = _steps(path, rel, work, row, args)
     # no machine's paths in the table: the corpus and work folders by name
-    done["why"] = done["why"].replace(str(root), root.name).replace(str(work), "OUT")
+    why = done["why"].replace(str(root), root.name).replace(str(work), "OUT")
+    done["why"] = why.replace(str(Path.home()), "~")
     return done
 
 
