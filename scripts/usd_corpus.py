@@ -255,12 +255,44 @@ def _close(a, b, scale: float, floor: float) -> bool:
     return bool(np.max(np.abs(np.asarray(a, float) - np.asarray(b, float))) <= TOL * scale + floor)
 
 
-def _compare_bodies(kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn) -> list[str]:
+def _merged(kit: Kit, bodies: dict, welded: dict[str, str]) -> tuple[dict, dict]:
+    """(original body -> the kit link it is in, kit-side name -> summed original mass): a
+    body the kit lacks that is welded to its parent (a fixed joint; a converter merges such
+    bodies into one rigid body) counts in its parent's link."""
+    into = {}
+    for name in bodies:
+        at, seen = name, set()
+        while kit.name("links", at) not in kit.links and at in welded and at not in seen:
+            seen.add(at)
+            at = welded[at]
+        into[name] = at
+    masses: dict[str, float] = {}
+    for name, (mass, _) in bodies.items():
+        masses[into[name]] = masses.get(into[name], 0.0) + mass
+    return into, masses
+
+
+def _combined(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple:
+    """(CoM, inertia about it) of bodies (mass, CoM, inertia about own CoM), one frame."""
+    total = sum(m for m, _, _ in parts)
+    com = sum(m * c for m, c, _ in parts) / total
+    tensor = np.zeros((3, 3))
+    for m, c, i in parts:
+        d = c - com
+        tensor += i + m * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
+    return com, tensor
+
+
+def _compare_bodies(
+    kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn, welded: dict[str, str]
+) -> list[str]:
     """Common comparison: `bodies` original name -> (mass, None), `joints` original name ->
     (type, limits or None), `poses_fn(rng)` -> (q for the kit by original joint name,
-    {original body: (CoM, inertia) in the root frame})."""
+    {original body: (CoM, inertia) in the root frame}); `welded`: body -> the parent it is
+    fixed to (bodies the kit lacks are compared merged into it, `_merged`)."""
     out = []
-    for name, (mass, _) in sorted(bodies.items()):
+    into, merged = _merged(kit, bodies, welded)
+    for name, mass in sorted(merged.items()):
         link = kit.links.get(kit.name("links", name))
         if link is None:
             out.append(f"link {name} missing")
@@ -283,7 +315,11 @@ def _compare_bodies(kit: Kit, bodies: dict[str, tuple], joints: dict, poses_fn) 
         return out
     rng = np.random.default_rng(0)
     for _ in range(SEEDS):
-        q, wanted = poses_fn(rng)
+        q, each = poses_fn(rng)
+        groups: dict[str, list] = {}
+        for name, (com, tensor) in each.items():
+            groups.setdefault(into[name], []).append((bodies[name][0], com, tensor))
+        wanted = {name: _combined(parts) for name, parts in groups.items()}
         poses = _spec_poses(kit.spec, {kit.name("joints", k): v for k, v in q.items()})
         for name, (com, tensor) in sorted(wanted.items()):
             link = kit.name("links", name)
@@ -350,7 +386,8 @@ def compare_urdf(path: Path, spec: dict) -> list[str]:
             wanted[name] = (pose[:3, 3], pose[:3, :3] @ tensor @ pose[:3, :3].T)
         return q, wanted
 
-    return _compare_bodies(kit, bodies, joints, poses_fn)
+    welded = {j.child: j.parent for j in robot.joints if j.type == "fixed"}
+    return _compare_bodies(kit, bodies, joints, poses_fn, welded)
 
 
 def _urdf_poses(robot, root: str, q: dict) -> dict[str, np.ndarray]:
@@ -431,7 +468,12 @@ def compare_mjcf(path: Path, spec: dict) -> list[str]:
             wanted[name[b]] = (pose[:3, 3], pose[:3, :3] @ tensor @ pose[:3, :3].T)
         return q, wanted
 
-    return _compare_bodies(kit, bodies, joints, poses_fn)
+    welded = {
+        name[b]: name.get(int(model.body_parentid[b]), "")
+        for b in mine
+        if model.body_jntnum[b] == 0 and b != top
+    }
+    return _compare_bodies(kit, bodies, joints, poses_fn, welded)
 
 
 def table(rows: list[dict], title: str, command: str) -> str:
