@@ -168,3 +168,15 @@ def test_world_joints_chain(tmp_path) -> None:
     assert (joints["rail"]["parent"], joints["rail"]["child"]) == ("world", "rail_link")
     assert (joints["yaw"]["parent"], joints["yaw"]["child"]) == ("rail_link", "base")
     assert joints["rail"]["type"] == "prismatic" and joints["yaw"]["type"] == "continuous"
+
+
+def test_two_articulations_of_one_robot(tmp_path) -> None:
+    """Several articulation roots each bolted to the world by a fixed joint from the robot's
+    own prim (urdf-usd-converter's form of a massless root link with several fixed children)
+    are one fixed-base robot; bolted by joints from nowhere they are two robots (above)."""
+    path = arm(tmp_path / "arm.usda", two_roots=True)
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    joints = _by_name(spec["joints"])
+    assert (joints["post_joint"]["parent"], joints["post_joint"]["child"]) == ("world", "post")
+    assert joints["post_joint"]["xyz"] == pytest.approx([0.3, 0, 0])
+    assert _by_name(spec["links"])["post"]["mass"] == 0.7

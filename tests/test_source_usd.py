@@ -55,11 +55,13 @@ def _v(values) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-@pytest.fixture(scope="module", params=[False, True], ids=["arm", "two_dof_body"])
+@pytest.fixture(scope="module", params=["plain", "chain", "two_roots"])
 def imported(tmp_path_factory, request):
-    """The arm imported; with two joints between one pair of bodies (a chain)."""
+    """The arm imported; with two joints between one pair of bodies (a chain); with two
+    articulations bolted to the robot's prim."""
     folder = tmp_path_factory.mktemp("usd_source")
-    done = import_robot(arm(folder / "arm.usda", chain=request.param), folder / "out")
+    options = {} if request.param == "plain" else {request.param: True}
+    done = import_robot(arm(folder / "arm.usda", **options), folder / "out")
     return done.spec_path, yaml.safe_load(done.spec_path.read_text())
 
 

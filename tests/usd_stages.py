@@ -15,6 +15,7 @@ def arm(
     loop: bool | None = None,
     chain: bool = False,
     rail: bool = False,
+    two_roots: bool = False,
 ) -> Path:
     """A fixed-base two-link arm per robot: `base` (box, MassAPI 2 kg) bolted to the world,
     `upper` on a revolute joint about Z (-90..45 degrees), `slider` on a prismatic joint
@@ -25,7 +26,9 @@ def arm(
     `chain` a second revolute joint `twist` (about X, at the shoulder) joins `base` and
     `upper` too: a body with two degrees of freedom, as MJCF writes it; with `rail`, two
     joints without body0 hold `base` to the world in place of the fixed one: `rail`
-    (prismatic along X), then `yaw` (revolute about Z)."""
+    (prismatic along X), then `yaw` (revolute about Z); with `two_roots` the articulation
+    root is on `base` and on a second body `post` (0.7 kg) bolted 0.3 m along X, both by
+    fixed joints from the robot's own prim: two articulations of one robot."""
     from pxr import Gf, Usd, UsdGeom, UsdPhysics
 
     stage = Usd.Stage.CreateNew(str(path))
@@ -53,6 +56,21 @@ def arm(
             cube.CreateDisplayColorAttr([Gf.Vec3f(0.2, 0.4, 0.6)])
             bodies[name] = xf.GetPath()
         _joints(stage, f"/arm{r}", bodies, unit)
+        if two_roots:
+            top.GetPrim().RemoveAPI(UsdPhysics.ArticulationRootAPI)
+            UsdPhysics.ArticulationRootAPI.Apply(stage.GetPrimAtPath(bodies["base"]))
+            post = UsdGeom.Xform.Define(stage, f"/arm{r}/post")
+            post.AddTranslateOp().Set(Gf.Vec3d(0.3 * unit, 0, 0))
+            UsdPhysics.RigidBodyAPI.Apply(post.GetPrim())
+            UsdPhysics.ArticulationRootAPI.Apply(post.GetPrim())
+            UsdPhysics.MassAPI.Apply(post.GetPrim()).CreateMassAttr(0.7)
+            for name, body in (("world_joint", bodies["base"]), ("post_joint", post.GetPath())):
+                bolt = UsdPhysics.FixedJoint.Define(stage, f"/arm{r}/{name}")
+                bolt.CreateBody0Rel().SetTargets([top.GetPath()])
+                bolt.CreateBody1Rel().SetTargets([body])
+            UsdPhysics.FixedJoint(stage.GetPrimAtPath(f"/arm{r}/post_joint")).CreateLocalPos0Attr(
+                Gf.Vec3f(0.3 * unit, 0, 0)
+            )
         if rail:
             stage.RemovePrim(f"/arm{r}/world_joint")
             for name, kind, axis in (("rail", UsdPhysics.PrismaticJoint, "X"),

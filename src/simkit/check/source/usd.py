@@ -272,13 +272,15 @@ class Robot:
     root: str = ""
     #: (joint name, flipped) in breadth-first order from the root
     tree: list[tuple[str, bool]] = field(default_factory=list)
+    #: further root bodies bolted to the world -> their pose relative to the root body
+    bolted: dict[str, np.ndarray] = field(default_factory=dict)
     #: tree joint -> the further joints between the same two bodies (a multi-DOF body)
     chains: dict[str, list[str]] = field(default_factory=dict)
 
     def poses(self, q: dict[str, float]) -> dict[str, np.ndarray]:
         """Each body's pose relative to the root body at joint values `q` (rad or m; a
         spherical joint J from J_x, J_y, J)."""
-        out = {self.root: np.eye(4)}
+        out = {self.root: np.eye(4), **self.bolted}
         for name, flip in self.tree:
             j = self.joints[name]
             motion = _motion(j, name, q)
@@ -474,6 +476,14 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
                 robot.bodies[root].frame = _moved(j.pose0)
                 break
     robot.root, todo, seen = root, [root], {root}
+    if held and held[0].kind == "fixed":  # further articulations bolted to the world alike
+        base = held[0].pose0 @ _inv(held[0].pose1)
+        for _, j in world:
+            if j.kind == "fixed" and j.body1 in bodies and j.body1 not in {*claimed, root}:
+                robot.bodies[j.body1].frame = _moved(j.pose1)
+                robot.bolted[j.body1] = _inv(base) @ j.pose0 @ _inv(j.pose1)
+                seen.add(j.body1)
+                todo.append(j.body1)
     while todo:
         at = todo.pop(0)
         for name, j in sorted(inner.items()):

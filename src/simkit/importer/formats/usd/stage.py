@@ -31,6 +31,9 @@ class Articulation:
     joints: list[object] = field(default_factory=list)
     variant: str | None = None
     notes: list[str] = field(default_factory=list)
+    #: further root bodies, each bolted to the world like the first (several articulations
+    #: of one robot: urdf-usd-converter writes one per child of a massless root link)
+    more_roots: list[str] = field(default_factory=list)
 
 
 def open_stage(path: Path, root_layer, variant: str | None):
@@ -65,7 +68,9 @@ def articulation(path: Path, stage) -> Articulation:
     joints = [p for p in prims if p.IsA(UsdPhysics.Joint) and p.IsActive()]
     roots = [p for p in prims if p.HasAPI(UsdPhysics.ArticulationRootAPI)]
     linking = [j for j in joints if {t for t in _ends(j) if t} & bodies]
-    if len(roots) > 1:
+    graph = _graph(linking, bodies)
+    held = _bolted(roots, graph, bodies, linking) if len(roots) > 1 else []
+    if len(roots) > 1 and not held:
         names = ", ".join(str(p.GetPath()) for p in roots[:4])
         raise SpecError(
             str(path), None, f"prim {roots[1].GetPath()}",
@@ -79,9 +84,8 @@ def articulation(path: Path, stage) -> Articulation:
     notes = []
     if not roots:
         notes.append("no PhysicsArticulationRootAPI: the stage's jointed bodies read as one robot")
-    graph = _graph(linking, bodies)
-    root = _root_body(roots[0] if roots else None, graph, bodies, linking)
-    found = _connected(root, graph)
+    root = held[0] if held else _root_body(roots[0] if roots else None, graph, bodies, linking)
+    found = set().union(*(_connected(r, graph) for r in held or [root]))
     if not roots:  # without a root, jointed bodies apart from the robot are another robot
         rest = bodies - found - {b for b in bodies if not graph.get(b)}
         if rest:
@@ -96,7 +100,31 @@ def articulation(path: Path, stage) -> Articulation:
             f"{sorted(apart)[0]}): objects of the scene, not the robot"
         )
     touching = [j for j in linking if {t for t in _ends(j) if t} & found]
-    return Articulation(stage, stage.GetPrimAtPath(root), sorted(found), touching, notes=notes)
+    out = Articulation(stage, stage.GetPrimAtPath(root), sorted(found), touching, notes=notes)
+    out.more_roots = held[1:]
+    return out
+
+
+def _bolted(roots, graph, bodies: set[str], joints: list) -> list[str]:
+    """The root bodies of several articulations that are one robot: each held to the world
+    by a fixed joint from the same prim that is no body and holds them all (the robot's own
+    prim); [] when they are not (several robots)."""
+    from pxr import UsdPhysics
+
+    out, hubs = [], set()
+    for prim in roots:
+        body = _root_body(prim, graph, bodies, joints)
+        fixed = [
+            j for j in joints
+            if j.IsA(UsdPhysics.FixedJoint) and _ends(j)[1] == body and _ends(j)[0] not in bodies
+        ]  # fmt: skip
+        if not fixed:
+            return []
+        hubs.add(_ends(fixed[0])[0])
+        out.append(body)
+    hub = next(iter(hubs)) if len(hubs) == 1 else None
+    inside = hub is not None and all(b.startswith(f"{hub}/") for b in out)
+    return sorted(set(out)) if inside else []
 
 
 def _ends(joint) -> tuple[str | None, str | None]:

@@ -60,6 +60,8 @@ class Context:
     names: dict[str, str] = field(default_factory=dict)
     listed: list[tuple[str, str]] = field(default_factory=list)
     dropped: list[tuple[object, str]] = field(default_factory=list)
+    #: further root bodies -> the fixed joint bolting each to the world
+    bolts: dict = field(default_factory=dict)
     #: massless links added between the joints of one pair of bodies (_chain)
     added: list[str] = field(default_factory=list)
     #: id(joint) -> its frame's turn in the child's body axes (the axis is turned by it)
@@ -116,6 +118,9 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
         etree.SubElement(robot, "link", name=WORLD).sourceline = 0
         origin = _world_origin(base, ctx)
         order = [*_chain(base, world, WORLD, ctx.names[root], False, origin, ctx), *order]
+        for body, joint in sorted(ctx.bolts.items()):
+            bolt = (joint, WORLD, ctx.names[body], False, _world_origin(joint, ctx))
+            order.insert(1, bolt)
     for body in art.bodies:
         if body in frames:
             _link(robot, body, frames[body], ctx)
@@ -149,12 +154,14 @@ def _walk(art: Articulation, root: str, ctx: Context):
     bodies = set(art.bodies)
     frames: dict[str, np.ndarray] = {}
     base, loops, order = None, [], []
-    tree_joints, claimed, extras = [], {}, {}
+    tree_joints, claimed, extras, bolts = [], {}, {}, {}
     for joint in art.joints:
         a, b = ends(joint)
         excluded = bool(UsdPhysics.Joint(joint).GetExcludeFromArticulationAttr().Get())
         world = (a not in bodies) != (b not in bodies)
-        if world and base is None and root in (a, b) and not excluded:
+        if world and b in art.more_roots and b not in bolts and not excluded:
+            bolts[b] = joint  # a further articulation of the robot, bolted to the world
+        elif world and base is None and root in (a, b) and not excluded:
             base = joint
         elif world and base is not None and b == root == ends(base)[1] and not excluded:
             extras.setdefault(id(base), []).append(joint)  # more DOF between world and root
@@ -170,7 +177,10 @@ def _walk(art: Articulation, root: str, ctx: Context):
         end = 1 if ends(base)[1] == root else 0
         last = (extras.get(id(base)) or [base])[-1]
         frames[root] = _at(local_pose(last, end, ctx))
-    todo, used = [root], set()
+    for body, joint in bolts.items():
+        frames[body] = _at(local_pose(joint, 1, ctx))
+    ctx.bolts = bolts
+    todo, used = [root, *sorted(bolts)], set()
     while todo:
         body = todo.pop(0)
         for joint in tree_joints:
