@@ -8,7 +8,9 @@ composes (issue 39).
   into a scratch folder the import removes); the base floats unless a joint holds the root
   body to the world; loop joints left out by the URDF repair `second_parents`;
 - `keep`: every layer as read, byte for byte (kept.py), the variant read in `source.args`,
-  and the differences: the shared ones (formats/provenance.py) and the listed ones.
+  and the differences: the shared ones (formats/provenance.py) and the listed ones;
+- `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
+  (fixups/falling.py), as an MJCF's is.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
 from simkit.importer.formats.urdf import repairs
 from simkit.importer.formats.usd import confine, kept, stage, tree
@@ -92,5 +95,27 @@ def keep(draft) -> None:
     draft.changed()
 
 
+def mark_falling(draft) -> None:
+    """A floating robot that does not stand on the kit's servos (fixups/falling.py: a
+    humanoid made for a balance controller) is built, not refused, as for an MJCF: the
+    spec's `needs_active_balance` gives the settle's figures, robot.json and the README say
+    so, and the legged check holds its base suspended. One report line."""
+    drop = falling.sinks(draft)
+    if drop is None:
+        return
+    reason = (
+        f"on the kit's position servos at home its base sinks {drop:.2f} m in {settle.SECONDS:g} s"
+    )
+    draft.spec["needs_active_balance"] = reason
+    draft.changed()
+    draft.report.changed(
+        draft.kept,
+        Position("stage", None),
+        f"a free base that needs active balance ({reason}; a kit carries no balance "
+        "controller): built, said in robot.json and the README; the legged check holds the "
+        "base suspended instead of standing",
+    )
+
+
 EDITS = ()
-AFTER = ()
+AFTER = (mark_falling,)
