@@ -331,7 +331,7 @@ def _compare_bodies(
                 far = float(np.max(np.abs(got_com - com)))
                 return [f"link {name}: CoM off by {far:.3g} m at a seeded configuration"]
             scale = float(np.linalg.norm(tensor))
-            if scale == 0.0:  # the original gives its body no inertia: nothing to compare
+            if scale < 1e-12:  # the original gives its body no inertia: nothing to compare
                 continue
             if "inertia" not in estimated and not _close(got_tensor, tensor, scale, 1e-12):
                 return [f"link {name}: inertia (root frame) differs at a seeded configuration"]
