@@ -102,13 +102,13 @@ def test_closed_loop_dropped(tmp_path, excluded: bool) -> None:
 
 def test_two_joints_one_pair(tmp_path) -> None:
     """Two joints between one pair of bodies (a body with two degrees of freedom): a chain
-    through an added massless link, in path order, listed as added."""
+    through an added massless link, in the stage's order, listed as added."""
     path = arm(tmp_path / "arm.usda", chain=True)
     spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
     joints = _by_name(spec["joints"])
     assert (joints["shoulder"]["parent"], joints["shoulder"]["child"]) == ("base", "shoulder_link")
-    assert (joints["twist"]["parent"], joints["twist"]["child"]) == ("shoulder_link", "upper")
-    assert joints["twist"]["axis"] == [1.0, 0.0, 0.0]
+    assert (joints["a_twist"]["parent"], joints["a_twist"]["child"]) == ("shoulder_link", "upper")
+    assert joints["a_twist"]["axis"] == [1.0, 0.0, 0.0]
     assert "links.shoulder_link" in {d["what"] for d in spec["source_differences"]}
 
 
@@ -161,7 +161,7 @@ def test_loose_body_noted(tmp_path) -> None:
 
 def test_world_joints_chain(tmp_path) -> None:
     """Several joints holding the root body to the world (a base on slides and a hinge, as
-    MJCF writes a mobile base) are a chain from the world link, in path order."""
+    MJCF writes a mobile base) are a chain from the world link, in the stage's order."""
     path = arm(tmp_path / "arm.usda", rail=True)
     spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
     joints = _by_name(spec["joints"])

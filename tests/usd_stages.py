@@ -23,7 +23,8 @@ def arm(
     `heavy` variant sets `upper`'s mass to 3 kg (default `light`: 1 kg); with `loop` a
     fixed joint `loop` from `base` to `slider` closes a loop (True: marked
     excludeFromArticulation; False: not marked, so `slider` has two parent joints); with
-    `chain` a second revolute joint `twist` (about X, at the shoulder) joins `base` and
+    `chain` a second revolute joint `a_twist` (about X, at the shoulder, authored after
+    `shoulder` but before it by path) joins `base` and
     `upper` too: a body with two degrees of freedom, as MJCF writes it; with `rail`, two
     joints without body0 hold `base` to the world in place of the fixed one: `rail`
     (prismatic along X), then `yaw` (revolute about Z); with `two_roots` the articulation
@@ -79,7 +80,7 @@ def arm(
                 joint.CreateBody1Rel().SetTargets([bodies["base"]])
                 joint.CreateAxisAttr(axis)
         if chain:
-            twist = UsdPhysics.RevoluteJoint.Define(stage, f"/arm{r}/twist")
+            twist = UsdPhysics.RevoluteJoint.Define(stage, f"/arm{r}/a_twist")
             twist.CreateBody0Rel().SetTargets([bodies["base"]])
             twist.CreateBody1Rel().SetTargets([bodies["upper"]])
             twist.CreateLocalPos0Attr(Gf.Vec3f(0, 0, 0.5 * unit))

@@ -260,7 +260,8 @@ class Joint:
     pose1: np.ndarray
     axis: int = 0
     limits: tuple[float, float] | None = None
-    path: str = ""
+    #: the joint's place in the stage's order (as authored: the order of a chain's joints)
+    order: int = 0
 
 
 @dataclass
@@ -382,6 +383,8 @@ def source_robot(path: Path, variant: str | None) -> Robot:
             joints.append((str(at), label, desc))
             joint_paths.append(str(at))
     joint_names = _unique(stage, joint_paths)
+    every = Usd.PrimRange(stage.GetPseudoRoot(), Usd.TraverseInstanceProxies())
+    authored = {str(p.GetPath()): i for i, p in enumerate(every)}
     robot = Robot()
     for at, label, d in sorted(joints):
         b0, b1 = str(d.body0), str(d.body1)
@@ -393,7 +396,7 @@ def source_robot(path: Path, variant: str | None) -> Robot:
         if label in ("revolute", "prismatic"):
             joint.axis = "XYZ".index(str(d.axis).rsplit(".", 1)[-1][-1])
             joint.limits = _limits_of(d.limit, label, meters)
-        joint.path = at
+        joint.order = authored.get(at, 0)
         if not d.excludeFromArticulation:
             robot.joints[joint_names[at]] = joint
     for at, name in names.items():
@@ -446,7 +449,7 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
     roots = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.ArticulationRootAPI)]
     root = names.get(str(roots[0].GetPath())) if roots else None
     inner, claimed = {}, {}
-    for n, j in sorted(robot.joints.items(), key=lambda item: item[1].path):
+    for n, j in sorted(robot.joints.items(), key=lambda item: item[1].order):
         if not (j.body0 in bodies and j.body1 in bodies):
             continue
         first = claimed.get(j.body1)
@@ -467,7 +470,7 @@ def _walk(robot: Robot, stage, names: dict[str, str]) -> None:
     if root is None:
         children = {j.body1 for j in inner.values()}
         root = next(n for n in sorted(bodies) if n not in children and _touches(n, inner))
-    held = [j for _, j in sorted(world, key=lambda item: item[1].path) if root == j.body1]
+    held = [j for _, j in sorted(world, key=lambda item: item[1].order) if root == j.body1]
     if held:  # the last of the joints holding the root to the world (a chain), as imported
         robot.bodies[root].frame = _moved(held[-1].pose1)
     else:

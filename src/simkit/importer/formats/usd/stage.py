@@ -23,7 +23,7 @@ VARIANT_SET = "Physics"
 @dataclass
 class Articulation:
     """The robot on the stage: its root prim, bodies (prim paths, sorted) and joints
-    (UsdPhysics.Joint prims, sorted by path) that touch them."""
+    (UsdPhysics.Joint prims, in the stage's order as authored) that touch them."""
 
     stage: object
     root_prim: object

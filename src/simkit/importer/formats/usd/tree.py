@@ -18,7 +18,7 @@ velocity. A joint with no body0 (or a body0 that is no rigid body) joins the rob
 world: on the root body a fixed one bolts the base (a `world` link), another moves it.
 Other joint types are read as fixed and listed; a drive's stiffness and damping are not read
 (the kit sizes its own servos). A joint with `excludeFromArticulation`, or one closing a
-loop (a body's second parent joint, in path order), is emitted after the tree, so the URDF
+loop (a body's second parent joint, in the stage's order), is emitted after the tree, so the URDF
 repair `second_parents` leaves it out (listed as dropped).
 
 Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
@@ -168,7 +168,7 @@ def _walk(art: Articulation, root: str, ctx: Context):
         elif not (world or excluded) and b in claimed and ends(claimed[b])[0] == a:
             extras.setdefault(id(claimed[b]), []).append(joint)  # one more DOF, the same pair
         elif world or excluded or b in claimed:
-            loops.append(joint)  # a body's second parent joint (path order) closes a loop
+            loops.append(joint)  # a body's second parent joint (stage order) closes a loop
         else:
             claimed[b] = joint
             tree_joints.append(joint)
@@ -212,7 +212,8 @@ def _chain(first, rest: list, parent: str, child: str, flip: bool, origin, ctx: 
     """Order entries (joint, parent link, child link, flipped, origin) of the joints between
     one pair of bodies: one joint, or several (a body with several degrees of freedom, as
     MJCF writes it and mujoco-usd-converter keeps it) made a chain through added massless
-    links `JOINT_link`, each joint turning about its own frame on body1, in path order."""
+    links `JOINT_link`, each joint turning about its own frame on body1, in the stage's
+    order (as authored: an MJCF body's joint order)."""
     if not rest:
         return [(first, parent, child, flip, origin)]
     joints = [first, *rest]
