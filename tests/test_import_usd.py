@@ -180,3 +180,22 @@ def test_two_articulations_of_one_robot(tmp_path) -> None:
     assert (joints["post_joint"]["parent"], joints["post_joint"]["child"]) == ("world", "post")
     assert joints["post_joint"]["xyz"] == pytest.approx([0.3, 0, 0])
     assert _by_name(spec["links"])["post"]["mass"] == 0.7
+
+
+def test_zero_inertia_without_com(tmp_path) -> None:
+    """A MassAPI with a mass and moments written as zero but no centerOfMass (a URDF link
+    whose inertial has no origin, as urdf-usd-converter writes it) has its CoM at the body
+    origin, not at its collider's centre."""
+    from pxr import Gf, Usd, UsdGeom, UsdPhysics
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    api = UsdPhysics.MassAPI(stage.GetPrimAtPath("/arm0/slider"))
+    api.GetCenterOfMassAttr().Clear()
+    api.GetDiagonalInertiaAttr().Set(Gf.Vec3f(0, 0, 0))
+    UsdGeom.Xformable(stage.GetPrimAtPath("/arm0/slider/box")).AddTranslateOp().Set(
+        Gf.Vec3d(0.2, 0, 0)
+    )
+    stage.GetRootLayer().Save()
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    assert _by_name(spec["links"])["slider"]["com"] == pytest.approx([0, 0, 0])

@@ -435,8 +435,8 @@ def _mass_of(prim, meters: float, kilograms: float) -> Body:
             q = axes.Get()
             turn = _quat(float(q.GetReal()), *(float(v) for v in q.GetImaginary()))
         body.inertia = turn @ moments @ turn.T * kilograms * meters * meters
-        if body.com is None and body.mass is not None:
-            body.com = np.zeros(3)  # inertia about a CoM left unwritten: the body origin
+    if diagonal.HasAuthoredValue() and body.com is None and body.mass is not None:
+        body.com = np.zeros(3)  # inertia written about a CoM left unwritten: the body origin
     return body
 
 

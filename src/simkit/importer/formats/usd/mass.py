@@ -1,10 +1,11 @@
 """A body's mass properties in its link frame: UsdPhysics MassAPI where authored, else the
 solid of its collision shapes at the body's density (tree.py's module docstring).
 
-A MassAPI that gives the mass and the principal moments but no `centerOfMass` puts the CoM at
-the body's origin: the author computed the inertia about a point, and the converters that
-write mass properties (NVIDIA's urdf-usd-converter) leave a zero CoM unwritten. Without the
-inertia, the CoM (and inertia) come from the colliders' solid, as UsdPhysics says."""
+A MassAPI that gives the mass and the principal moments (even zero ones) but no
+`centerOfMass` puts the CoM at the body's origin: the author wrote the inertia about a point,
+and the converters that write mass properties (NVIDIA's urdf-usd-converter) leave a zero CoM
+unwritten. Without the moments, the CoM (and inertia) come from the colliders' solid, as
+UsdPhysics says."""
 
 from __future__ import annotations
 
@@ -42,7 +43,7 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
     if kg <= 0:
         kg = solid[0]
         ctx.listed.append((f"{key}.mass", "no MassAPI mass: the colliders' solid at its density"))
-    given = diagonal is not None and np.any(np.asarray(diagonal) > 0)
+    given = diagonal is not None  # authored, even as zero: the author wrote the inertia
     if given and kg > 0 and (com is None or not np.all(np.asarray(com) > UNSET)):
         com = (0.0, 0.0, 0.0)  # inertia given about a CoM left unwritten: the body origin
     if com is not None and np.all(np.asarray(com) > UNSET):
