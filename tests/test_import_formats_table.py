@@ -19,8 +19,18 @@ XACRO = (
 
 
 def test_the_two_tables_name_the_same_formats():
-    assert [f.name for f in formats.FORMATS] == ["xacro", "mjcf", "sdf", "urdf"]
-    assert set(formats.BY_NAME) == set(source_check.COMPARE) == {"urdf", "xacro", "mjcf", "sdf"}
+    assert [f.name for f in formats.FORMATS] == ["xacro", "mjcf", "sdf", "usd", "urdf"]
+    assert (
+        set(formats.BY_NAME)
+        == set(source_check.COMPARE)
+        == {
+            "urdf",
+            "xacro",
+            "mjcf",
+            "sdf",
+            "usd",
+        }
+    )
 
 
 def test_every_format_module_gives_sniff_read_and_keep():
@@ -44,6 +54,8 @@ def test_the_format_is_picked_by_what_the_file_is(tmp_path):
     assert (picked.format.name, picked.title) == ("mjcf", "Two Arm")
     (tmp_path / "u.xml").write_text("<robot name='r'><link name='a'/></robot>")
     assert formats.pick(tmp_path / "u.xml").format.name == "urdf"
+    for name in ("r.usd", "r.usda", "r.USDC"):  # a USD by its suffix
+        assert formats.pick(tmp_path / name).format.name == "usd"
     xacro = tmp_path / "r.urdf.xacro"
     xacro.write_text(XACRO)
     doc = formats.load(xacro, (), Report())

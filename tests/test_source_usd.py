@@ -1,86 +1,114 @@
-"""The source proof reads the composed USD stage (issue 33, check/source/kit_usd.py): each
-link's mass and each movable joint's type and limits in the kit's entry USD, composed with
-its payloads, agree with the imported URDF's. A tampered physics payload fails."""
+"""The USD source proof (check/source/usd.py, issue 39) on a kit URDF written from the
+imported spec: it passes on the robot the stage describes, and fails, naming the link or
+joint, on a mass, a limit or a joint origin that differs."""
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
+import json
+import math
 
 import pytest
+import yaml
+from tests.usd_stages import arm
 
 from simkit.check.kit import Kit
-from simkit.check.source import check_source
+from simkit.check.source import usd as source_usd
 from simkit.importer import import_robot
-from simkit.kitio import layout
-from urdf_parts import joint, link, write
+
+pytest.importorskip("pxr")
 
 
-@pytest.fixture(scope="module")
-def kit(tmp_path_factory) -> Path:
-    from simkit.pipeline import build
-
-    folder = tmp_path_factory.mktemp("source_usd")
-    body = (
-        link("base", mass="3"),
-        link("upper", mass="2"),
-        link("lower", mass="1.5"),
-        joint("shoulder", "base", "upper"),
-        joint("elbow", "upper", "lower", limit='lower="-0.5" upper="2" effort="40" velocity="2"'),
-    )
-    done = import_robot(write(folder, "arm2", *body), folder / "out")
-    return build(str(done.spec_path), folder / "kits").kit_dir
-
-
-def _source_usd(kit: Path, original: Path | None = None) -> list:
-    """source.usd findings, with the source the import kept beside the spec (found from the
-    `original` kit's place when `kit` is a copy)."""
-    (source,) = ((original or kit).parent.parent / "out").glob("*.source.urdf")
-    return [f for f in check_source(Kit.open(kit, source)) if f.check == "source.usd"]
-
-
-def _tampered(kit: Path, tmp_path: Path, pattern: str, replacement: str) -> Path:
-    import shutil
-
-    copy = tmp_path / kit.name
-    shutil.copytree(kit, copy)
-    physics = copy / layout.usd_payload(copy.name.removesuffix("_description"), "physics.usda")
-    text, count = re.subn(pattern, replacement, physics.read_text(), count=1)
-    assert count == 1
-    physics.write_text(text)
-    return copy
+def _urdf(spec: dict) -> str:
+    """The spec's links and joints as URDF text (what the build's URDF carries)."""
+    out = ['<robot name="arm">']
+    for link in spec["links"]:
+        i = link["inertia"]
+        out += [
+            f'<link name="{link["name"]}"><inertial><origin xyz="{_v(link["com"])}"/>',
+            f'<mass value="{link["mass"]!r}"/><inertia ixx="{i["ixx"]!r}" ixy="{i.get("ixy", 0)!r}"'
+            f' ixz="{i.get("ixz", 0)!r}" iyy="{i["iyy"]!r}" iyz="{i.get("iyz", 0)!r}"'
+            f' izz="{i["izz"]!r}"/></inertial></link>',
+        ]
+    out += ['<link name="world"/>', *(f'<link name="{n}"/>' for n in _added(spec))]
+    for j in spec["joints"]:
+        limit = ""
+        if "lower" in j:
+            limit = (
+                f'<limit lower="{j["lower"]!r}" upper="{j["upper"]!r}" effort="1" velocity="1"/>'
+            )
+        out.append(
+            f'<joint name="{j["name"]}" type="{j["type"]}"><parent link="{j["parent"]}"/>'
+            f'<child link="{j["child"]}"/><origin xyz="{_v(j.get("xyz", [0, 0, 0]))}"'
+            f' rpy="{_v(j.get("rpy", [0, 0, 0]))}"/><axis xyz="{_v(j.get("axis", [1, 0, 0]))}"/>'
+            f"{limit}</joint>"
+        )
+    return "\n".join([*out, "</robot>"])
 
 
-def test_the_composed_stage_agrees_with_the_source(kit):
-    found = _source_usd(kit)
-    assert found and all(f.ok for f in found), [f.line() for f in found]
-    assert "3 link masses and 2 movable joints" in found[0].line()
+def _added(spec: dict) -> list[str]:
+    """Links the joints name that the spec's links do not hold (massless chain links)."""
+    named = {link["name"] for link in spec["links"]} | {"world"}
+    return sorted({j["child"] for j in spec["joints"]} - named)
 
 
-def test_a_tampered_mass_in_the_physics_payload_fails(kit, tmp_path):
-    copy = _tampered(kit, tmp_path, r"(float physics:mass = )[0-9.e+-]+", r"\g<1>9.5")
-    failures = [f.line() for f in _source_usd(copy, kit) if not f.ok]
-    assert any("mass" in line and "in the USD" in line for line in failures), failures
+def _v(values) -> str:
+    return " ".join(repr(float(v)) for v in values)
 
 
-def test_a_tampered_joint_limit_fails(kit, tmp_path):
-    copy = _tampered(kit, tmp_path, r"(float physics:upperLimit = )[0-9.e+-]+", r"\g<1>10")
-    failures = [f.line() for f in _source_usd(copy, kit) if not f.ok]
-    assert any("limits" in line for line in failures), failures
+@pytest.fixture(scope="module", params=["plain", "chain", "two_roots"])
+def imported(tmp_path_factory, request):
+    """The arm imported; with two joints between one pair of bodies (a chain); with two
+    articulations bolted to the robot's prim."""
+    folder = tmp_path_factory.mktemp("usd_source")
+    options = {} if request.param == "plain" else {request.param: True}
+    done = import_robot(arm(folder / "arm.usda", **options), folder / "out")
+    return done.spec_path, yaml.safe_load(done.spec_path.read_text())
 
 
-def test_a_placeholder_span_the_kit_makes_continuous_is_a_listed_difference(tmp_path):
-    """Revolute limits of +-1e16 rad (a spinning rotor's placeholder) become a continuous
-    joint, listed in source_differences; the USD has no limits there, and source.usd
-    accepts the listed difference."""
-    from simkit.pipeline import build
+def _findings(tmp_path, imported, change=None) -> list:
+    spec_path, spec = imported
+    spec = json.loads(json.dumps(spec))
+    if change:
+        change(spec)
+    kit = tmp_path / "kit"
+    kit.mkdir()
+    (kit / "arm.urdf").write_text(_urdf(spec))
+    doc = {"name": "arm", "files": {"urdf": "arm.urdf"}, "source": spec["source"]}
+    doc["source_differences"] = spec.get("source_differences", [])
+    (kit / "robot.json").write_text(json.dumps(doc))
+    given = spec_path.parent / spec["source"]["file"]
+    return source_usd.compare(Kit(kit, given), given)
 
-    body = (
-        link("base", mass="3"),
-        link("rotor", mass="0.5"),
-        joint("spin", "base", "rotor", limit='lower="-1e16" upper="1e16" effort="5" velocity="50"'),
-    )
-    done = import_robot(write(tmp_path, "prop", *body), tmp_path / "out")
-    kit = build(str(done.spec_path), tmp_path / "kits").kit_dir
-    found = _source_usd(kit)
-    assert found and all(f.ok for f in found), [f.line() for f in found]
+
+def _by_name(items: list[dict]) -> dict:
+    return {item["name"]: item for item in items}
+
+
+def test_passes(tmp_path, imported) -> None:
+    found = _findings(tmp_path, imported)
+    assert all(f.ok for f in found), [str(f) for f in found if not f.ok]
+    assert {f.check for f in found} >= {"source.joints", "source.links", "source.fk"}
+
+
+def test_mass_differs(tmp_path, imported) -> None:
+    def heavier(spec):
+        _by_name(spec["links"])["upper"]["mass"] *= 1.001
+
+    failed = [f.detail for f in _findings(tmp_path, imported, heavier) if not f.ok]
+    assert any("'upper': mass" in d for d in failed)
+
+
+def test_limit_differs(tmp_path, imported) -> None:
+    def wider(spec):
+        _by_name(spec["joints"])["shoulder"]["upper"] = math.radians(50)
+
+    failed = [f.detail for f in _findings(tmp_path, imported, wider) if not f.ok]
+    assert any("'shoulder': upper" in d for d in failed)
+
+
+def test_origin_differs(tmp_path, imported) -> None:
+    def moved(spec):
+        _by_name(spec["joints"])["slide"]["xyz"] = [0.0, 0.0, 0.5001]
+
+    failed = [f for f in _findings(tmp_path, imported, moved) if not f.ok]
+    assert any(f.check == "source.fk" and "'slider'" in f.detail for f in failed)

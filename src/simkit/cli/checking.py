@@ -19,11 +19,11 @@ from simkit.errors import SimkitError
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
     help="Also compare the kit with the file it was imported from: a URDF, a xacro, an "
-    "MJCF or an SDFormat file (kinematics, limits, mass).",
+    "MJCF, an SDFormat file or a USD (kinematics, limits, mass).",
 )
 def check(kit_dir: Path, verbose: bool, source: Path | None) -> None:
     """Run the checks on a built kit (folder or zip); with --source, also compare it with
-    the URDF, xacro, MJCF or SDFormat file it was imported from."""
+    the URDF, xacro, MJCF, SDFormat file or USD it was imported from."""
     import tempfile
 
     from simkit.check import run_checks

@@ -1,4 +1,4 @@
-"""`simkit import`: a URDF, xacro, MJCF or SDFormat file to a spec YAML and meshes (importer)."""
+"""`simkit import`: a URDF, xacro, MJCF, SDFormat file or USD to a spec YAML and meshes."""
 
 from __future__ import annotations
 
@@ -56,6 +56,9 @@ from simkit.errors import SimkitError
     help="Folder outside the robot's package that meshes and includes may read; repeatable.",
 )
 @click.option("--trust-xacro", is_flag=True, help="Run the xacro as is (trusted files only).")
+@click.option(
+    "--variant", default=None, help="USD: the Physics variant to read. [default: the stage's]"
+)
 def import_urdf(
     path: Path,
     name: str | None,
@@ -71,10 +74,11 @@ def import_urdf(
     allow_env: tuple[str, ...],
     allow_read: tuple[Path, ...],
     trust_xacro: bool,
+    variant: str | None,
 ) -> None:
-    """Turn a URDF, a xacro, an MJCF (MuJoCo's XML, a <mujoco> file) or an SDFormat file
-    (.sdf, or a Gazebo model folder with model.config) at PATH into OUT/NAME.yaml plus the
-    meshes it needs."""
+    """Turn a URDF, a xacro, an MJCF (MuJoCo's XML, a <mujoco> file), an SDFormat file
+    (.sdf, or a Gazebo model folder with model.config) or a USD (a UsdPhysics articulation:
+    .usd, .usda, .usdc) at PATH into OUT/NAME.yaml plus the meshes it needs."""
     from simkit.importer import import_robot
     from simkit.importer.read.options import ReadOptions, parse_xacro_arg
 
@@ -83,7 +87,11 @@ def import_urdf(
     floating = True if floating_base else False if fixed_base else None
     try:
         reading = ReadOptions(
-            tuple(parse_xacro_arg(a) for a in xacro_args), allow_env, allow_read, trust_xacro
+            tuple(parse_xacro_arg(a) for a in xacro_args),
+            allow_env,
+            allow_read,
+            trust_xacro,
+            variant,
         )
         done = import_robot(
             path,

@@ -2,10 +2,11 @@
 
 robot.json's `source.format` (the import's formats.FORMATS row) picks the comparison in
 `COMPARE`, one module per format, each reading the source with an implementation other than
-the importer's reader: urdf.py (yourdfpy; a xacro's kept source is its expansion, a URDF)
-and mjcf.py (MuJoCo compiles both the source and the kit's MJCF), sdf.py (Drake's SDFormat
-parser reads the source and the kit's URDF). The first two also compare the
-source with the kit's USD (kit_usd.py). First the given file's digest is checked against the
+the importer's reader: urdf.py (yourdfpy; a xacro's kept source is its expansion, a URDF),
+mjcf.py (MuJoCo compiles both the source and the kit's MJCF), sdf.py (Drake's SDFormat
+parser reads the source and the kit's URDF) and usd.py (usd-core's UsdPhysics parser reads
+the composed stage). Each also compares the source with the kit's USD (kit_usd.py). First
+the given file's digest is checked against the
 one the import recorded, or the original's (shared.py): the file the user imported (a URDF,
 a xacro expanded with the recorded args) is read again as the import read it, and must give
 the kept file. A kit imported before robot.json named the format is read by its kept
@@ -20,7 +21,7 @@ from types import ModuleType
 
 from simkit.check.findings import Finding
 from simkit.check.kit import Kit
-from simkit.check.source import mjcf, sdf, urdf
+from simkit.check.source import mjcf, sdf, urdf, usd
 from simkit.check.source.shared import Allowed, digest
 
 __all__ = ["COMPARE", "Allowed", "check_source", "format_of"]
@@ -28,7 +29,13 @@ __all__ = ["COMPARE", "Allowed", "check_source", "format_of"]
 #: robot.json `source.format` -> the module proving the kit is that source: its
 #: `compare(kit, path)` (the findings) and `remake(path, args)` (the kept file's bytes made
 #: from the original the user imported)
-COMPARE: dict[str, ModuleType] = {"urdf": urdf, "xacro": urdf, "mjcf": mjcf, "sdf": sdf}
+COMPARE: dict[str, ModuleType] = {
+    "urdf": urdf,
+    "xacro": urdf,
+    "mjcf": mjcf,
+    "sdf": sdf,
+    "usd": usd,
+}
 
 
 def format_of(doc: dict) -> str:

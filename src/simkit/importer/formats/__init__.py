@@ -28,7 +28,7 @@ from pathlib import Path
 
 from simkit.importer import read
 from simkit.importer.diagnostics import Report
-from simkit.importer.formats import mjcf, sdf, urdf, xacro
+from simkit.importer.formats import mjcf, sdf, urdf, usd, xacro
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -61,6 +61,7 @@ FORMATS: tuple[Format, ...] = (
     _module_row("xacro", xacro),
     _module_row("mjcf", mjcf),
     _module_row("sdf", sdf),
+    _module_row("usd", usd),
     _module_row("urdf", urdf),
 )
 BY_NAME = {f.name: f for f in FORMATS}

@@ -19,16 +19,19 @@ class ReadOptions:
     """`xacro_args`: (NAME, VALUE) for `$(arg NAME)` in .xacro and .urdf alike;
     `allow_env`: environment variables `$(env)`/`$(optenv)` may read; `allow_read`: folders
     outside the package root that meshes, includes and load_yaml may read; `trust_xacro`:
-    full xacro (its Python evaluator, the environment, any file) for a trusted file."""
+    full xacro (its Python evaluator, the environment, any file) for a trusted file;
+    `variant`: a USD stage's Physics variant."""
 
     xacro_args: tuple[tuple[str, str], ...] = ()
     allow_env: tuple[str, ...] = ()
     allow_read: tuple[Path, ...] = ()
     trust_xacro: bool = False
+    #: a USD stage's `Physics` variant to read (`--variant`; None: the stage's default)
+    variant: str | None = None
 
     def args(self) -> dict[str, str]:
-        """`--xacro-arg` values by name (the last one given wins)."""
-        return dict(self.xacro_args)
+        """`--xacro-arg` values by name (the last one given wins), and the `--variant`."""
+        return dict(self.xacro_args) | ({"variant": self.variant} if self.variant else {})
 
 
 def parse_xacro_arg(text: str) -> tuple[str, str]:

@@ -1,0 +1,121 @@
+"""USD: a UsdPhysics articulation (`.usd`, `.usda`, `.usdc`), read from the stage usd-core
+composes (issue 39).
+
+- `read`: every layer the file composes checked to lie inside the model's folder and to be
+  USD before the stage opens (confine.py), the stage composed with the `Physics` variant the
+  user names (`--variant`) or its default (stage.py), its one articulation found, then made
+  the tree the shared translation takes (tree.py, mass.py, shapes.py; meshes written as STL
+  into a scratch folder the import removes); the base floats unless a joint holds the root
+  body to the world; loop joints left out by the URDF repair `second_parents`;
+- `keep`: every layer as read, byte for byte (kept.py), the variant read in `source.args`,
+  and the differences: the shared ones (formats/provenance.py) and the listed ones;
+- `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
+  (fixups/falling.py), as an MJCF's is.
+"""
+
+from __future__ import annotations
+
+import copy
+import shutil
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from simkit.importer.fixups import falling, settle
+from simkit.importer.formats import provenance
+from simkit.importer.formats.urdf import repairs
+from simkit.importer.formats.usd import confine, kept, stage, tree
+from simkit.importer.read.lenient import Position
+from simkit.importer.read.options import ReadOptions
+from simkit.importer.read.source import Source
+
+#: the kit's own words for the source, in report lines and the spec's header
+NOUN = "USD"
+SUFFIXES = (".usd", ".usda", ".usdc")
+
+
+def sniff(path: Path, head: bytes) -> bool:
+    """A `.usd`, `.usda` or `.usdc` file (a text layer starts `#usda`, a crate `PXR-USDC`)."""
+    return path.suffix.lower() in SUFFIXES or head.startswith((b"#usda", b"PXR-USDC"))
+
+
+def title(head: bytes) -> str | None:
+    """No name from the head: the spec is named after the file."""
+    return None
+
+
+@dataclass
+class UsdSource(Source):
+    """A read USD: the layers' bytes (`files`, relative to the model's folder), the
+    variant read and the listed differences."""
+
+    files: dict[str, bytes] = field(default_factory=dict)
+    variant: str | None = None
+    listed: list[tuple[str, str]] = field(default_factory=list)
+
+
+def read(shell: Source, options: ReadOptions) -> Source:
+    """The composed stage's articulation as a URDF-shaped tree (module docstring)."""
+    allowed = (shell.path.resolve().parent, *(p.resolve() for p in options.allow_read))
+    layers = confine.open_layers(shell.path, allowed)
+    opened, variant = stage.open_stage(shell.path, layers.root, options.variant)
+    art = stage.articulation(shell.path, opened)
+    scratch = Path(tempfile.mkdtemp(prefix="simkit-usd-"))
+    source = UsdSource(shell.path, None, shell.packages, shell.report)
+    source.scratch.append(scratch)
+    try:
+        source.root, floating, listed, dropped = tree.to_tree(art, scratch)
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
+    source.packages.allow_read = (*source.packages.allow_read, scratch.resolve())
+    source.files, source.variant, source.listed = layers.files, variant, listed
+    for note in art.notes:
+        source.note(Position("stage", None), note)
+    for joint, why in dropped:
+        source.note(Position(f"joint {joint.GetPath()}", None), f"not imported: {why}")
+    source.base = (
+        floating,
+        "floating base: no joint holds the USD's root body to the world; --fixed-base bolts it"
+        if floating
+        else "fixed base: a joint holds the USD's root body to the world; --floating-base frees it",
+    )
+    source.kept = replace(source, root=copy.deepcopy(source.root))
+    repairs.second_parents(source, source.report)
+    return source
+
+
+def keep(draft) -> None:
+    """Every layer as read (kept.py); `source` and `source_differences`."""
+    original = draft.kept
+    spec = draft.spec
+    spec["source"] = kept.keep(draft, original)
+    listed = provenance.differences(spec, original, draft.report, draft.renames)
+    spec["source_differences"] = provenance.merged(listed, [*original.listed, *draft.listed])
+    draft.changed()
+
+
+def mark_falling(draft) -> None:
+    """A floating robot that does not stand on the kit's servos (fixups/falling.py: a
+    humanoid made for a balance controller) is built, not refused, as for an MJCF: the
+    spec's `needs_active_balance` gives the settle's figures, robot.json and the README say
+    so, and the legged check holds its base suspended. One report line."""
+    drop = falling.sinks(draft)
+    if drop is None:
+        return
+    reason = (
+        f"on the kit's position servos at home its base sinks {drop:.2f} m in {settle.SECONDS:g} s"
+    )
+    draft.spec["needs_active_balance"] = reason
+    draft.changed()
+    draft.report.changed(
+        draft.kept,
+        Position("stage", None),
+        f"a free base that needs active balance ({reason}; a kit carries no balance "
+        "controller): built, said in robot.json and the README; the legged check holds the "
+        "base suspended instead of standing",
+    )
+
+
+EDITS = ()
+AFTER = (mark_falling,)
