@@ -1,5 +1,6 @@
 """Help texts name every format a command takes (issue 38): `simkit import --help`, `simkit
-check --help` and README's command table name URDF, xacro and MJCF, not "a URDF" alone."""
+check --help` and README's command table name URDF, xacro, MJCF, SDFormat and USD, not "a
+URDF" alone."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from click.testing import CliRunner
 from simkit.cli import main
 
 README = Path(__file__).resolve().parents[1] / "README.md"
-FORMATS = ("URDF", "xacro", "MJCF")
+FORMATS = ("URDF", "xacro", "MJCF", "SDF", "USD")  # "SDF" also matches "SDFormat"
 
 
 @pytest.mark.parametrize("command", ["import", "check"])
@@ -21,7 +22,7 @@ def test_the_help_names_every_format_the_command_takes(command):
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())  # click wraps lines
     for name in FORMATS:
-        assert re.search(rf"\b{name}\b", text, re.IGNORECASE), (command, name, text)
+        assert re.search(rf"\b{name}", text, re.IGNORECASE), (command, name, text)
     if command == "check":  # the option itself, not only the command's summary
         option = text[text.index("--source FILE") :]
         assert all(name.lower() in option.lower() for name in FORMATS), option
