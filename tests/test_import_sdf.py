@@ -2,7 +2,7 @@
 against Drake's SDFormat parser (libsdformat inside pydrake, a test-only dependency) on small
 files written for each construct: `relative_to` poses and `<frame>`s, a joint's default frame
 (its child link), `expressed_in` axes, nested and merged `<include>`s through `model://`; and
-the one-line refusals. The comparison is the source proof's (check/source/sdf.py): the tree
+the one-line refusals. The comparison is the source proof's (check/source/sdf/): the tree
 the reader gives is written as a URDF and read by Drake beside the SDF."""
 
 from __future__ import annotations

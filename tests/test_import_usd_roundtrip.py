@@ -1,6 +1,6 @@
 """A seed kit's own USD (its entry point, default physx variant) imports back to the kit's
 robot (issue 39): the imported kit passes its checks, its `source` findings (the USD proof,
-check/source/usd.py) pass, and its URDF equals the original kit's URDF within the source
+check/source/usd/) pass, and its URDF equals the original kit's URDF within the source
 check's tolerances (masses, CoMs, inertias, joint origins, axes, types and limits), but for
 the efforts (the USD's drive `maxForce` is the servo's, not the URDF's effort limit)."""
 

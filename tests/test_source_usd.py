@@ -1,4 +1,4 @@
-"""The USD source proof (check/source/usd.py, issue 39) on a kit URDF written from the
+"""The USD source proof (check/source/usd/, issue 39) on a kit URDF written from the
 imported spec: it passes on the robot the stage describes, and fails, naming the link or
 joint, on a mass, a limit or a joint origin that differs."""
 

@@ -112,7 +112,7 @@ CHECK_LIBRARIES = (
     "manifold3d",
     "cadquery-ocp",
     "cadquery-ocp-novtk",
-    "drake",  # the SDFormat source proof (check/source/sdf.py)
+    "drake",  # the SDFormat source proof (check/source/sdf/)
 )
 
 

@@ -3,8 +3,8 @@
 robot.json's `source.format` (the import's formats.FORMATS row) picks the comparison in
 `COMPARE`, one module per format, each reading the source with an implementation other than
 the importer's reader: urdf.py (yourdfpy; a xacro's kept source is its expansion, a URDF),
-mjcf.py (MuJoCo compiles both the source and the kit's MJCF), sdf.py (Drake's SDFormat
-parser reads the source and the kit's URDF) and usd.py (usd-core's UsdPhysics parser reads
+mjcf.py (MuJoCo compiles both the source and the kit's MJCF), sdf/ (Drake's SDFormat
+parser reads the source and the kit's URDF) and usd/ (usd-core's UsdPhysics parser reads
 the composed stage). Each also compares the source with the kit's USD (kit_usd.py). First
 the given file's digest is checked against the
 one the import recorded, or the original's (shared.py): the file the user imported (a URDF,

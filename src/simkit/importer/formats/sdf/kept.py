@@ -3,7 +3,7 @@
 `NAME.source.assets/SHA256.EXT`; the spec's `source.assets` records them all (path relative
 to the model path, the model folder's parent -> SHA-256; the model file is the one whose
 digest is `source.sha256`: its entry gives its place). The source check
-(check/source/sdf.py) lays them out again, each top folder a model (`model://NAME`), and
+(check/source/sdf/) lays them out again, each top folder a model (`model://NAME`), and
 reads them with Drake.
 """
 

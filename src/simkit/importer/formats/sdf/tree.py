@@ -22,6 +22,13 @@ from __future__ import annotations
 import numpy as np
 
 from simkit.importer.formats.sdf import universal
+from simkit.importer.formats.sdf.elements import (
+    axis_in_joint,
+    fmt,
+    in_model,
+    limits,
+    origin,
+)
 from simkit.importer.formats.sdf.frames import (
     MODEL,
     WORLD,
@@ -29,7 +36,6 @@ from simkit.importer.formats.sdf.frames import (
     inverse,
     numbers,
     pose_of,
-    rpy_of,
     scoped,
 )
 
@@ -41,12 +47,6 @@ KINDS = {
     "fixed": "fixed",
     "ball": "spherical",
 }
-#: |limit| at or above which an SDF limit means none (the specification's default is 1e16)
-NO_LIMIT = 1e15
-
-
-def fmt(values) -> str:
-    return " ".join(repr(float(v)) for v in np.ravel(values))
 
 
 class Model:
@@ -180,8 +180,8 @@ def _frames(robot, model: Model, kit_frame: dict[str, str], on_model: str) -> No
         joint = _free(f"{name}_joint", taken)
         out = etree.SubElement(robot, "joint", name=joint, type="fixed")
         out.sourceline = element.sourceline
-        parent = _in_model(model, kit_frame.get(link, link), element)
-        _origin(out, inverse(parent) @ model.frames.in_model(name, element))
+        parent = in_model(model, kit_frame.get(link, link), element)
+        origin(out, inverse(parent) @ model.frames.in_model(name, element))
         etree.SubElement(out, "parent", link=link)
         etree.SubElement(out, "child", link=name)
         etree.SubElement(robot, "link", name=name).sourceline = element.sourceline
@@ -193,19 +193,6 @@ def _free(name: str, taken: set[str]) -> str:
         out, n = f"{name}_{n}", n + 1
     taken.add(out)
     return out
-
-
-def _in_model(model: Model, name: str, element) -> np.ndarray:
-    """A frame's pose in the top model frame (the world: the model's pose inverted)."""
-    if name == WORLD:
-        return inverse(model.source.placed)
-    return model.frames.in_model(name, element)
-
-
-def _origin(parent, x: np.ndarray) -> None:
-    from lxml import etree
-
-    etree.SubElement(parent, "origin", xyz=fmt(x[:3, 3]), rpy=fmt(rpy_of(x[:3, :3])))
 
 
 def _placed(model: Model, element, link: str, kit: np.ndarray) -> np.ndarray:
@@ -231,7 +218,7 @@ def _link(robot, model: Model, name: str, element, frame: str) -> None:
     if inertial is not None and inertial.get("auto") in ("true", "1"):
         raise model.source.fail(inertial, "automatic inertia (<inertial auto>): not read")
     out = etree.SubElement(link, "inertial")
-    _origin(
+    origin(
         out,
         _placed(model, inertial, name, kit)
         if inertial is not None
@@ -278,7 +265,7 @@ def _shape(link, model: Model, name: str, shape, tag: str, k: int, kit: np.ndarr
     if shape.get("name"):
         out.set("name", shape.get("name"))
     out.sourceline = shape.sourceline
-    _origin(out, _placed(model, shape, name, kit))
+    origin(out, _placed(model, shape, name, kit))
     geo = etree.SubElement(out, "geometry")
     src = model.source
 
@@ -320,61 +307,10 @@ def _joint(robot, model: Model, name: str, joint, parent: str, child: str, kit_f
     out.sourceline = joint.sourceline
     x_joint = model.frames.in_model(name, joint)
     parent_frame = kit_frame.get(parent, parent)
-    _origin(out, inverse(_in_model(model, parent_frame, joint)) @ x_joint)
+    origin(out, inverse(in_model(model, parent_frame, joint)) @ x_joint)
     etree.SubElement(out, "parent", link=parent)
     etree.SubElement(out, "child", link=child)
     if kind in ("fixed", "ball"):
         return
     etree.SubElement(out, "axis", xyz=fmt(axis_in_joint(model, joint, "axis", x_joint)))
-    _limits(out, src, joint.find("axis"), kind)
-
-
-def axis_in_joint(model: Model, joint, tag: str, x_joint: np.ndarray) -> np.ndarray:
-    """The unit axis of `<axis>` (or `<axis2>`) in the joint frame: its `<xyz>` expressed in
-    the joint frame unless `expressed_in` (or 1.4-1.6 `use_parent_model_frame`) says."""
-    src = model.source
-    axis = joint.find(tag)
-    xyz = axis.find("xyz") if axis is not None else None
-    if xyz is None:
-        raise src.fail(joint, f"a {joint.get('type')} joint without <{tag}><xyz>")
-    vector = np.asarray(numbers(src, xyz, xyz.text, 3))
-    if not np.linalg.norm(vector):
-        raise src.fail(xyz, "a zero axis")
-    frame = xyz.get("expressed_in")
-    if not frame and (axis.findtext("use_parent_model_frame") or "").strip() in ("true", "1"):
-        frame = MODEL
-    if frame:
-        rot = x_joint[:3, :3].T @ _in_model(model, scoped(xyz.get("scope", ""), frame), xyz)[:3, :3]
-        vector = rot @ vector
-    return vector / np.linalg.norm(vector)
-
-
-def _limits(out, src, axis, kind: str) -> None:
-    from lxml import etree
-
-    limit = axis.find("limit")
-
-    def value(tag: str) -> float | None:
-        found = None if limit is None else limit.find(tag)
-        return None if found is None else numbers(src, found, found.text, 1)[0]
-
-    lower, upper, effort, velocity = (value(t) for t in ("lower", "upper", "effort", "velocity"))
-    bounded = lower is not None and upper is not None and max(abs(lower), abs(upper)) < NO_LIMIT
-    if kind == "revolute" and not bounded:
-        out.set("type", "continuous")
-    attrs = {"lower": fmt([lower]), "upper": fmt([upper])} if bounded else {}
-    if effort is not None and effort > 0:
-        attrs["effort"] = fmt([effort])
-    if velocity is not None and velocity > 0:
-        attrs["velocity"] = fmt([velocity])
-    if attrs:
-        etree.SubElement(out, "limit", **attrs)
-    damping = axis.findtext("dynamics/damping")
-    friction = axis.findtext("dynamics/friction")
-    if damping or friction:
-        etree.SubElement(
-            out,
-            "dynamics",
-            damping=fmt([float(damping or 0)]),
-            friction=fmt([float(friction or 0)]),
-        )
+    limits(out, src, joint.find("axis"), kind)

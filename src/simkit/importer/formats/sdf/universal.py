@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.importer.formats.sdf.frames import transform
+from simkit.importer.formats.sdf.elements import axis_in_joint, in_model, limits, origin
+from simkit.importer.formats.sdf.frames import inverse, transform
 
 #: |cos| between the two axes above which they are not perpendicular
 PERPENDICULAR = 1e-6
@@ -21,8 +22,6 @@ PERPENDICULAR = 1e-6
 
 def axes(model, name: str, joint) -> tuple[np.ndarray, np.ndarray]:
     """The two unit axes in the joint frame; one line when they are not perpendicular."""
-    from simkit.importer.formats.sdf.tree import axis_in_joint
-
     x_joint = model.frames.in_model(name, joint)
     first, second = (axis_in_joint(model, joint, tag, x_joint) for tag in ("axis", "axis2"))
     if abs(float(first @ second)) > PERPENDICULAR:
@@ -44,8 +43,6 @@ def emit(robot, model, ends: tuple, kit_frame: dict[str, str]) -> None:
     """The two revolute joints and the link between them, into `robot`."""
     from lxml import etree
 
-    from simkit.importer.formats.sdf.tree import _in_model, _limits, _origin, inverse
-
     name, parent, child, joint = ends
     frame = kit_frame.get(child)
     if frame != f"{name}#universal":  # a second parent (a loop): left out by the repair
@@ -56,14 +53,14 @@ def emit(robot, model, ends: tuple, kit_frame: dict[str, str]) -> None:
         out = etree.SubElement(robot, "joint", name=joint_name, type="revolute")
         out.sourceline = joint.sourceline
         if k == 0:
-            parent_pose = _in_model(model, kit_frame.get(up, up), joint)
-            _origin(out, inverse(parent_pose) @ model.frames.in_model(frame, joint))
+            parent_pose = in_model(model, kit_frame.get(up, up), joint)
+            origin(out, inverse(parent_pose) @ model.frames.in_model(frame, joint))
         else:
-            _origin(out, np.eye(4))
+            origin(out, np.eye(4))
         etree.SubElement(out, "parent", link=up)
         etree.SubElement(out, "child", link=down)
         etree.SubElement(out, "axis", xyz=xyz)
-        _limits(out, model.source, joint.find(tag), "revolute")
+        limits(out, model.source, joint.find(tag), "revolute")
     etree.SubElement(robot, "link", name=mid).sourceline = joint.sourceline
     why = "added: the link between a universal joint's two axes"
     model.source.listed += [(f"links.{mid}", why), (f"joints.{name}_1", why)]

@@ -1,7 +1,7 @@
 """The kept source of a USD import: the root layer as read, byte for byte
 (`NAME.source.usd|usda|usdc`), and every other layer the stage composed as
 `NAME.source.assets/SHA256.EXT`, their digests in the spec's `source` (`assets`: path
-relative to the root layer's folder -> SHA-256). The source check (check/source/usd.py) lays
+relative to the root layer's folder -> SHA-256). The source check (check/source/usd/) lays
 them out again with their relative paths and composes the stage from them.
 """
 

@@ -9,7 +9,7 @@ in the link's axes, and its origin `localPose0` turned back by `localRot1`. So a
 link frames a converter kept reads back with those frames. A joint written child-first (its
 body0 further from the root) is turned round: the frames swap and its axis flips, its limits
 stay. The source check
-(check/source/usd.py) applies the same rule to usd-core's own physics parser.
+(check/source/usd/) applies the same rule to usd-core's own physics parser.
 
 Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prismatic (m),
 Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce` is the
