@@ -61,4 +61,5 @@ def test_training_without_gpu_scene_fails(kit_factory, tmp_path):
 def test_unlimited_servo_means_no_training():
     doc = {"gpu_scene": {"file": "mjcf/x_mjx.xml"}, "actuators": [{"forcerange": "Infinity"}]}
     assert expected_training(doc) == "a servo without an effort limit"
+    assert expected_training({**doc, "actuators": [{"forcerange": None}]}) == expected_training(doc)
     assert expected_training({**doc, "actuators": []}).startswith("no position servos")

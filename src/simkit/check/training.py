@@ -249,7 +249,8 @@ def expected_training(doc: dict) -> str | None:
     servos = doc.get("actuators") or []
     if not servos:
         return "no position servos: neither a reach nor a stance task can act"
-    if any(not math.isfinite(float(a.get("forcerange", math.inf))) for a in servos):
+    efforts = [a.get("forcerange") for a in servos]
+    if any(e is None or not math.isfinite(float(e)) for e in efforts):
         return "a servo without an effort limit"
     return None
 
