@@ -34,7 +34,13 @@ from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
 from simkit.check.source import loops as source_loops
-from simkit.check.source.shared import Allowed, inertia_close
+from simkit.check.source.shared import (
+    SHOWN,
+    Allowed,
+    inertia_close,
+    unlisted_findings,
+    vector_text,
+)
 from simkit.kitio.oneline import one_line
 
 REL = 1e-6
@@ -42,7 +48,6 @@ ABS_LENGTH = 1e-9
 #: m and rotation-matrix entries: FK agreement
 FK_TOL = 1e-6
 SEEDS = 100
-SHOWN = 20
 #: mjtJoint
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 
@@ -78,23 +83,27 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
         why = " ".join(str(exc).split())[:200]
         return [require("source.read", False, f"MuJoCo cannot compile the kit: {why}")]
     pairs = Pairs(source, built, allowed)
-    out = _findings(
+    out = unlisted_findings(
         "source.joints",
         _joints(pairs),
         f"{source.njnt} joints: names, types, axes and ranges agree",
     )
-    out += _findings(
+    out += unlisted_findings(
         "source.links",
         _bodies(pairs),
         f"{len(pairs.bodies)} bodies: masses, CoMs and inertias agree",
     )
-    out += _findings(
+    out += unlisted_findings(
         "source.fk", _fk(pairs), f"every body's pose agrees at {SEEDS} seeded configurations"
     )
-    out += _findings("source.actuators", _actuators(pairs), "joint actuators' force bounds agree")
+    out += unlisted_findings(
+        "source.actuators", _actuators(pairs), "joint actuators' force bounds agree"
+    )
     declared = (kit.doc.get("collision_pairs") or {}).get("declared", [])
     excludes = _excludes(pairs, declared)
-    out += _findings("source.excludes", excludes, f"{source.nexclude} contact excludes agree")
+    out += unlisted_findings(
+        "source.excludes", excludes, f"{source.nexclude} contact excludes agree"
+    )
     out += source_loops.compare_mjcf(pairs, kit.doc)
     return out + source_usd.compare(kit, source_usd.source_of_mjcf(source), allowed)
 
@@ -205,8 +214,8 @@ def _joints(p: Pairs) -> list[str]:
             )
         if not np.allclose(s.jnt_axis[j], k.jnt_axis[kj], atol=REL) and not p.listed(f"{key}.axis"):
             out.append(
-                f"joint '{name}': axis {_v(s.jnt_axis[j])} in the source, "
-                f"{_v(k.jnt_axis[kj])} in the kit"
+                f"joint '{name}': axis {vector_text(s.jnt_axis[j])} in the source, "
+                f"{vector_text(k.jnt_axis[kj])} in the kit"
             )
         if s.jnt_limited[j]:
             for side, attr in ((0, "lower"), (1, "upper")):
@@ -253,11 +262,14 @@ def _bodies(p: Pairs) -> list[str]:
         if np.max(np.abs(c0 - c1)) > REL * np.max(np.abs(c0)) + ABS_LENGTH and not p.listed(
             f"{key}.com"
         ):
-            out.append(f"link '{name}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
+            out.append(
+                f"link '{name}': CoM {vector_text(c0)}"
+                f" m in the source, {vector_text(c1)} in the kit"
+            )
         if not inertia_close(i0, i1) and not p.listed(f"{key}.inertia"):
             out.append(
-                f"link '{name}': inertia {_v(np.diag(i0))} kg m^2 in the source, "
-                f"{_v(np.diag(i1))} in the kit"
+                f"link '{name}': inertia {vector_text(np.diag(i0))} kg m^2 in the source, "
+                f"{vector_text(np.diag(i1))} in the kit"
             )
     return out
 
@@ -402,16 +414,3 @@ def _excludes(p: Pairs, declared: list) -> list[str]:
         if frozenset((a, b)) not in source_pairs and not p.listed(f"contact_excludes.{a}.{b}"):
             out.append(f"links '{a}' and '{b}': declared excluded, not excluded in the source")
     return out
-
-
-def _findings(check: str, problems: list[str], ok_detail: str) -> list[Finding]:
-    if not problems:
-        return [require(check, True, ok_detail)]
-    out = [require(check, False, x + " (not listed in source_differences)") for x in problems]
-    if len(out) > SHOWN:
-        out = [*out[:SHOWN], require(check, False, f"and {len(out) - SHOWN} more")]
-    return out
-
-
-def _v(values) -> str:
-    return "(" + ", ".join(f"{float(v):.6g}" for v in np.ravel(values)) + ")"

@@ -40,6 +40,23 @@ def inertia_close(a, b) -> bool:
 SHOWN = 20
 
 
+def unlisted_findings(check: str, problems: list[str], ok: str) -> list[Finding]:
+    """One failing finding per problem the kit's `source_differences` does not list (at most
+    `SHOWN`, then "and N more"), or one passing finding saying `ok`: every format's proof
+    reports its differences this way."""
+    if not problems:
+        return [require(check, True, ok)]
+    out = [require(check, False, p + " (not listed in source_differences)") for p in problems]
+    if len(out) > SHOWN:
+        out = [*out[:SHOWN], require(check, False, f"and {len(out) - SHOWN} more")]
+    return out
+
+
+def vector_text(values) -> str:
+    """A vector in a finding, six significant digits: `(1, 0.5, 2)`."""
+    return "(" + ", ".join(f"{float(v):.6g}" for v in np.ravel(values)) + ")"
+
+
 @dataclass
 class Allowed:
     """robot.json's `source_differences`: allowed keys and the source -> kit renames."""

@@ -21,7 +21,14 @@ from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd as source_usd
 from simkit.check.source import loops as source_loops
-from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
+from simkit.check.source.shared import (
+    ABS_LENGTH,
+    REL,
+    Allowed,
+    inertia_close,
+    unlisted_findings,
+    vector_text,
+)
 from simkit.kitio.oneline import one_line
 
 #: attributes holding numbers that the comparison reads (origins, axes, limits, inertials)
@@ -150,13 +157,13 @@ def compare_robots(source, built, allowed: Allowed) -> list[Finding]:
     out: list[Finding] = []
     link_problems = _paired("link", source.links, built.links, allowed.links, allowed, _mass)
     joint_problems = _paired("joint", source.joints, built.joints, allowed.joints, allowed, _joint)
-    out += _findings(
+    out += unlisted_findings(
         "source.links",
         link_problems,
         f"{len(source.links)} links: names, masses, "
         "CoMs and inertias agree with the source or are listed differences",
     )
-    out += _findings(
+    out += unlisted_findings(
         "source.joints",
         joint_problems,
         f"{len(source.joints)} joints: names, "
@@ -193,15 +200,6 @@ def _kit_name(renames: dict[str, str], name: str, kit: dict) -> str:
     return new if new in kit or name not in kit else name
 
 
-def _findings(check: str, problems: list[str], ok_detail: str) -> list[Finding]:
-    if not problems:
-        return [require(check, True, ok_detail)]
-    out = [require(check, False, p + " (not listed in source_differences)") for p in problems]
-    if len(out) > SHOWN:
-        out = [*out[:SHOWN], require(check, False, f"and {len(out) - SHOWN} more")]
-    return out
-
-
 def _close(a, b, scale: float, floor: float) -> bool:
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     return bool(np.all(np.abs(a - b) <= REL * scale + floor))
@@ -229,11 +227,14 @@ def _mass(src, kit, allowed: Allowed) -> list[str]:
     if f"{key}.com" not in allowed.keys and not _close(
         c0, c1, float(np.max(np.abs(c0))), ABS_LENGTH
     ):
-        out.append(f"link '{shown}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
+        out.append(
+            f"link '{shown}': CoM {vector_text(c0)} m in the source, {vector_text(c1)} in the kit"
+        )
     if f"{key}.inertia" not in allowed.keys and not inertia_close(i0, i1):
         out.append(
-            f"link '{shown}': inertia (link axes) {_v(np.diag(i0))} kg m^2 on the diagonal "
-            f"in the source, {_v(np.diag(i1))} in the kit"
+            f"link '{shown}': inertia (link axes) {vector_text(np.diag(i0))}"
+            f" kg m^2 on the diagonal "
+            f"in the source, {vector_text(np.diag(i1))} in the kit"
         )
     return out
 
@@ -258,12 +259,16 @@ def _joint(src, kit, allowed: Allowed) -> list[str]:
     length = float(np.max(np.abs(o0[:3, 3])))
     same = _close(o0[:3, 3], o1[:3, 3], length, ABS_LENGTH)
     if not (same and _close(o0[:3, :3], o1[:3, :3], 1, 0)):
-        differs("origin", f"xyz {_v(o0[:3, 3])}", f"xyz {_v(o1[:3, 3])} (or its rotation)")
+        differs(
+            "origin",
+            f"xyz {vector_text(o0[:3, 3])}",
+            f"xyz {vector_text(o1[:3, 3])} (or its rotation)",
+        )
     if src.type in ("fixed", "floating") or kit.type in ("fixed", "floating"):
         return out
     a0, a1 = _unit(src.axis), _unit(kit.axis)
     if not _close(a0, a1, 1, 0):
-        differs("axis", _v(a0), _v(a1))
+        differs("axis", vector_text(a0), vector_text(a1))
     out += _limits(src, kit, allowed, key, name)
     return out
 
@@ -292,7 +297,3 @@ def _unit(axis) -> np.ndarray:
     a = np.asarray((1.0, 0.0, 0.0) if axis is None else axis, dtype=float)
     norm = float(np.linalg.norm(a))
     return a / norm if norm > 0 else a
-
-
-def _v(values) -> str:
-    return "(" + ", ".join(f"{float(v):.6g}" for v in np.ravel(values)) + ")"

@@ -9,9 +9,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.check.findings import Finding, require
+from simkit.check.findings import Finding
 from simkit.check.source.sdf.plant import Plant
-from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
+from simkit.check.source.shared import (
+    ABS_LENGTH,
+    REL,
+    Allowed,
+    inertia_close,
+    unlisted_findings,
+    vector_text,
+)
 from simkit.kitio.oneline import one_line
 
 FK_TOL = 1e-6
@@ -42,15 +49,15 @@ class Compare:
         return key in self.allowed.keys
 
     def findings(self) -> list[Finding]:
-        out = _findings(
+        out = unlisted_findings(
             "source.joints", self.joints(), f"{len(self.s.joints)} joints: types and limits agree"
         )
-        out += _findings(
+        out += unlisted_findings(
             "source.links",
             self.links(),
             f"{len(self.s.bodies)} bodies: masses, CoMs and inertias agree",
         )
-        return out + _findings(
+        return out + unlisted_findings(
             "source.fk", self.fk(), f"every body's pose agrees at {SEEDS} seeded configurations"
         )
 
@@ -110,11 +117,14 @@ class Compare:
             if np.max(np.abs(c0 - c1)) > REL * np.max(np.abs(c0)) + ABS_LENGTH and not self.listed(
                 f"{key}.com"
             ):
-                out.append(f"link '{name}': CoM {_v(c0)} m in the source, {_v(c1)} in the kit")
+                out.append(
+                    f"link '{name}': CoM {vector_text(c0)}"
+                    f" m in the source, {vector_text(c1)} in the kit"
+                )
             if not inertia_close(i0, i1) and not self.listed(f"{key}.inertia"):
                 out.append(
-                    f"link '{name}': inertia {_v(np.diag(i0))} kg m^2 in the source, "
-                    f"{_v(np.diag(i1))} in the kit"
+                    f"link '{name}': inertia {vector_text(np.diag(i0))} kg m^2 in the source, "
+                    f"{vector_text(np.diag(i1))} in the kit"
                 )
         return out
 
@@ -211,16 +221,3 @@ def _mass(body, x_bk: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     about_com = about_origin - mass * (float(com @ com) * np.eye(3) - np.outer(com, com))
     rot = x_bk[:3, :3].T
     return mass, rot @ (com - x_bk[:3, 3]), rot @ about_com @ rot.T
-
-
-def _findings(check: str, problems: list[str], ok: str) -> list[Finding]:
-    if not problems:
-        return [require(check, True, ok)]
-    out = [require(check, False, x + " (not listed in source_differences)") for x in problems]
-    return out[:SHOWN] + (
-        [require(check, False, f"and {len(out) - SHOWN} more")] if len(out) > SHOWN else []
-    )
-
-
-def _v(values) -> str:
-    return "(" + ", ".join(f"{float(v):.6g}" for v in np.ravel(values)) + ")"

@@ -32,7 +32,15 @@ import numpy as np
 from simkit.check.findings import Finding, require
 from simkit.check.kit import Kit
 from simkit.check.source import kit_usd
-from simkit.check.source.shared import ABS_LENGTH, REL, SHOWN, Allowed, inertia_close
+from simkit.check.source.shared import (
+    ABS_LENGTH,
+    REL,
+    SHOWN,
+    Allowed,
+    inertia_close,
+    unlisted_findings,
+    vector_text,
+)
 from simkit.check.source.urdf import load_urdf
 from simkit.check.source.usd.stage import Body, Joint, Robot, source_robot
 from simkit.kitio.oneline import one_line
@@ -82,10 +90,14 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
         why = " ".join(str(exc).split())[:200]
         return [require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
     allowed = Allowed.of(kit.doc)
-    out = _findings("source.joints", _joints(source, built, allowed), _said(source, "joints"))
-    out += _findings("source.links", _bodies(source, built, allowed), _said(source, "links"))
+    out = unlisted_findings(
+        "source.joints", _joints(source, built, allowed), _said(source, "joints")
+    )
+    out += unlisted_findings(
+        "source.links", _bodies(source, built, allowed), _said(source, "links")
+    )
     fk = _fk(source, built, allowed)
-    out += _findings("source.fk", fk, f"every body's pose agrees at {SEEDS} configurations")
+    out += unlisted_findings("source.fk", fk, f"every body's pose agrees at {SEEDS} configurations")
     return out + kit_usd.compare(kit, _for_kit_usd(source), allowed)
 
 
@@ -199,7 +211,10 @@ def _bodies(source: Robot, built, allowed: Allowed) -> list[str]:
         far = None if body.com is None else np.max(np.abs(com - body.com))
         bound = 0.0 if body.com is None else REL * np.max(np.abs(body.com)) + ABS_LENGTH
         if far is not None and f"{key}.com" not in allowed.keys and far > bound:
-            out.append(f"link '{name}': CoM {_v(body.com)} m in the USD, {_v(com)} in the kit")
+            out.append(
+                f"link '{name}': CoM {vector_text(body.com)}"
+                f" m in the USD, {vector_text(com)} in the kit"
+            )
         if body.inertia is not None and f"{key}.inertia" not in allowed.keys:
             tensor = pose[:3, :3] @ np.asarray(inertial.inertia) @ pose[:3, :3].T
             if not inertia_close(body.inertia, tensor):
@@ -239,19 +254,6 @@ def _fk(source: Robot, built, allowed: Allowed) -> list[str]:
         if out:
             return out[:SHOWN]
     return out
-
-
-def _findings(check: str, problems: list[str], ok: str) -> list[Finding]:
-    if not problems:
-        return [require(check, True, ok)]
-    found = [require(check, False, p + " (not listed in source_differences)") for p in problems]
-    if len(found) > SHOWN:
-        found = [*found[:SHOWN], require(check, False, f"and {len(found) - SHOWN} more")]
-    return found
-
-
-def _v(values) -> str:
-    return "(" + ", ".join(f"{float(v):.6g}" for v in np.ravel(values)) + ")"
 
 
 def kit_poses(built, q: dict[str, float]) -> dict[str, np.ndarray]:
