@@ -58,6 +58,17 @@ def as_read(source: Source) -> Source:
     return replace(source, root=copy.deepcopy(source.root))
 
 
+def record(draft, source_entry: dict) -> None:
+    """The spec's `source` (the kept files' entry a format's `keep` made) and its
+    `source_differences` (the shared ones and the format's listed ones): the end of every
+    format's `keep`."""
+    original, spec = draft.kept, draft.spec
+    spec["source"] = source_entry
+    listed = differences(spec, original, draft.report, draft.renames)
+    spec["source_differences"] = merged(listed, [*original.listed, *draft.listed])
+    draft.changed()
+
+
 def merged(listed: list[dict], extra: list[tuple[str, str]]) -> list[dict]:
     """`listed` with each (what, reason) of `extra` whose `what` it lacks, sorted by `what`."""
     seen = {d["what"] for d in listed}

@@ -106,12 +106,7 @@ def mark_falling(draft) -> None:
 
 def keep(draft) -> None:
     """The MJCF as read and its files kept (kept.py); `source` and `source_differences`."""
-    original = draft.kept
-    spec = draft.spec
-    spec["source"] = kept.keep(draft, original)
-    listed = provenance.differences(spec, original, draft.report, draft.renames)
-    spec["source_differences"] = provenance.merged(listed, [*original.listed, *draft.listed])
-    draft.changed()
+    provenance.record(draft, kept.keep(draft, draft.kept))
 
 
 EDITS = (carry_excludes,)

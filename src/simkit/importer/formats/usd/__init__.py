@@ -87,12 +87,7 @@ def read(shell: Source, options: ReadOptions) -> Source:
 
 def keep(draft) -> None:
     """Every layer as read (kept.py); `source` and `source_differences`."""
-    original = draft.kept
-    spec = draft.spec
-    spec["source"] = kept.keep(draft, original)
-    listed = provenance.differences(spec, original, draft.report, draft.renames)
-    spec["source_differences"] = provenance.merged(listed, [*original.listed, *draft.listed])
-    draft.changed()
+    provenance.record(draft, kept.keep(draft, draft.kept))
 
 
 def mark_falling(draft) -> None:
