@@ -16,12 +16,10 @@ from collections.abc import Iterator
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, model_validator
 
 from simkit.spec.names import name_problem
+from simkit.spec.placed import Placed
 
-# Own base types (not imported from schema.py, which imports this module).
-Vec3 = tuple[float, float, float]
 Problem = tuple[tuple, str]
 
 #: closure types a spec may name: a weld holds position and orientation
@@ -30,31 +28,14 @@ TYPES = ("weld",)
 POSE_TOL = 1e-6
 
 
-class LoopSpec(BaseModel):
+class LoopSpec(Placed):
     """One loop closure: `link2`'s frame held at `xyz`/`rpy` in `link1`'s frame (its pose at
     the spec's home). `link1` may be the root frame (the world)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     name: str
     type: Literal["weld"] = "weld"
     link1: str
     link2: str
-    xyz: Vec3 = (0.0, 0.0, 0.0)
-    rpy: Vec3 | None = None
-    rpy_deg: Vec3 | None = None
-
-    @model_validator(mode="after")
-    def _one_rpy(self) -> LoopSpec:
-        if self.rpy is not None and self.rpy_deg is not None:
-            raise ValueError("give rpy or rpy_deg, not both")
-        return self
-
-    def rpy_rad(self) -> Vec3:
-        """Orientation in radians."""
-        if self.rpy_deg is not None:
-            return tuple(math.radians(a) for a in self.rpy_deg)  # type: ignore[return-value]
-        return self.rpy or (0.0, 0.0, 0.0)
 
 
 def _unknown(name: str, known: set[str]) -> str:

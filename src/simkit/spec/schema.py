@@ -11,42 +11,16 @@ import math
 from collections.abc import Sequence
 from typing import Annotated, Literal, Protocol, TypeVar
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import ConfigDict, Field, field_validator, model_validator
 
 from simkit.spec.loops import LoopSpec
 from simkit.spec.mjcf import MjcfSpec
+from simkit.spec.placed import Placed, Strict, Vec3
 from simkit.spec.sim import FreefallSpec, InertiaDecisionSpec, Ros2ControlSpec
 
-Vec3 = tuple[float, float, float]
 Rgba = tuple[float, float, float, float]
 PositiveFloat = Annotated[float, Field(gt=0)]
 NonNegFloat = Annotated[float, Field(ge=0)]
-
-
-class Strict(BaseModel):
-    """Base: frozen, no unknown keys, finite floats only."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class Placed(Strict):
-    """A pose given as translation (m) and roll-pitch-yaw, in radians or degrees."""
-
-    xyz: Vec3 = (0.0, 0.0, 0.0)
-    rpy: Vec3 | None = None
-    rpy_deg: Vec3 | None = None
-
-    @model_validator(mode="after")
-    def _one_rpy(self) -> Placed:
-        if self.rpy is not None and self.rpy_deg is not None:
-            raise ValueError("give rpy or rpy_deg, not both")
-        return self
-
-    def rpy_rad(self) -> Vec3:
-        """Orientation in radians."""
-        if self.rpy_deg is not None:
-            return tuple(math.radians(a) for a in self.rpy_deg)  # type: ignore[return-value]
-        return self.rpy or (0.0, 0.0, 0.0)
 
 
 class Primitive(Placed):
@@ -333,13 +307,13 @@ class SourceSpec(Strict):
     args: dict[
         Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]{0,99}$")],
         Annotated[str, Field(max_length=1000)],
-    ] = {}
+    ] = Field(default_factory=dict)
     #: an MJCF's other files (includes, meshes, textures): path relative to the source's
     #: folder -> SHA-256; kept beside the spec as NAME.source.assets/SHA256.EXT
     assets: dict[
         Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_./ +-]{0,299}$")],
         Annotated[str, Field(pattern=r"^[0-9a-f]{64}$")],
-    ] = {}
+    ] = Field(default_factory=dict)
 
     @field_validator("assets")
     @classmethod
