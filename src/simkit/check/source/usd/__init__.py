@@ -5,7 +5,10 @@ frames, axes and limits), not the importer's reader; the kit's URDF is read by y
 Compared, under the source's prim names (made unique in path order, renames from robot.json):
 
 - joint types (revolute, continuous for an unbounded revolute, prismatic, fixed; a
-  spherical joint as the kit's three revolute joints J_x, J_y, J) and limits (degrees to rad);
+  spherical joint as the kit's three revolute joints J_x, J_y, J), limits (degrees to rad)
+  and efforts (N m or N: `simkit:effortLimit` where the joint carries it, as a simkit kit's
+  USD does, else the drive's maxForce, as the import reads them; listed as
+  `joints.NAME.effort_peak` where the import estimated it);
 - every body's MassAPI mass (kg, <= 1e-6 relative), CoM and inertia in the body frame;
 - the pose of every body relative to the root body at 100 seeded configurations (1e-6 m,
   1e-6 in rotation): the source's composed from the parser's joint frames
@@ -164,7 +167,7 @@ def _joints(source: Robot, built, allowed: Allowed) -> list[str]:
             got = "spherical" if all(f.type in ("revolute", "continuous") for f in found) else "?"
         if want != got and f"{key}.type" not in allowed.keys:
             out.append(f"joint '{name}': {want} in the USD, {got} in the kit")
-        if want in ("revolute", "prismatic") and want == got:
+        if want in ("revolute", "prismatic", "continuous") and want == got:
             out += _limits(name, joint, found[0], allowed)
     return out
 
@@ -176,15 +179,26 @@ def _kit_type(joint) -> str:
 
 
 def _limits(name: str, joint, kit, allowed: Allowed) -> list[str]:
+    """lower and upper (rad or m; none for a continuous joint) and the effort."""
     out = []
     for i, attr in enumerate(("lower", "upper")):
-        if f"joints.{name}.{attr}" in allowed.keys:
+        if joint.limits is None or f"joints.{name}.{attr}" in allowed.keys:
             continue
         want = joint.limits[i]
         got = None if kit.limit is None else getattr(kit.limit, attr)
         if got is None or abs(float(got) - want) > REL * abs(want) + ABS_LENGTH:
             out.append(f"joint '{name}': {attr} {want:.9g} in the USD, {got} in the kit")
-    return out
+    return out + _effort(name, joint, kit, allowed)
+
+
+def _effort(name: str, joint, kit, allowed: Allowed) -> list[str]:
+    """The source's effort limit (N m or N, where it carries one) against the kit's."""
+    if joint.effort is None or f"joints.{name}.effort_peak" in allowed.keys:
+        return []
+    got = None if kit.limit is None else kit.limit.effort
+    if got is None or abs(float(got) - joint.effort) > REL * joint.effort:
+        return [f"joint '{name}': effort {joint.effort:.9g} in the USD, {got} in the kit"]
+    return []
 
 
 def _bodies(source: Robot, built, allowed: Allowed) -> list[str]:

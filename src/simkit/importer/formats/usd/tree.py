@@ -12,10 +12,11 @@ stay. The source check
 (check/source/usd/) applies the same rule to usd-core's own physics parser.
 
 Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prismatic (m),
-Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce` is the
-joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) its
-velocity. A joint with no body0 (or a body0 that is no rigid body) joins the robot to the
-world: on the root body a fixed one bolts the base (a `world` link), another moves it.
+Fixed, Spherical (the translation's three revolute joints); effort and velocity as
+limits.py reads them (`simkit:effortLimit`, else the drive's `maxForce`; PhysX's
+`maxJointVelocity` or Newton's `velocityLimit`, deg/s). A joint with no body0 (or a body0
+that is no rigid body) joins the robot to the world: on the root body a fixed one bolts the
+base (a `world` link), another moves it.
 Other joint types are read as fixed and listed; a drive's stiffness and damping are not read
 (the kit sizes its own servos). A joint with `excludeFromArticulation`, or one closing a
 loop (a body's second parent joint, in the stage's order), is emitted after the tree, so the URDF
@@ -34,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.usd import poses, shapes
+from simkit.importer.formats.usd import limits, poses, shapes
 from simkit.importer.formats.usd.stage import Articulation, ends
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
@@ -362,19 +363,11 @@ def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
         }
     elif kind == "revolute":
         element.set("type", "continuous")
-    drive = "angular" if kind == "revolute" else "linear"
-    force = poses.get(joint, f"drive:{drive}:physics:maxForce")
-    if force is not None and 0 < float(force) < UNBOUNDED:
-        unit = (
-            ctx.units.kilograms
-            * ctx.units.meters
-            * (1 if kind == "prismatic" else ctx.units.meters)
-        )
-        limit["effort"] = poses.fmt([float(force) * unit])
-    speed = poses.get(joint, f"physxJointAxis:{drive}:maxJointVelocity")
-    for other in ("physxJoint:maxJointVelocity", "newton:velocityLimit"):
-        speed = speed if speed is not None else poses.get(joint, other)
-    if speed is not None and 0 < float(speed) < UNBOUNDED:
-        limit["velocity"] = poses.fmt([float(speed) * scale])
+    force = limits.effort(joint, kind, ctx.units)
+    if force is not None:
+        limit["effort"] = poses.fmt([force])
+    speed = limits.velocity(joint, kind)
+    if speed is not None:
+        limit["velocity"] = poses.fmt([speed * scale])
     if limit:
         etree.SubElement(element, "limit", **limit)
