@@ -1,7 +1,8 @@
 """A joint's effort limit survives the kit's USD (issue 39): the kit writes the spec's
 `effort_peak` (the URDF `<limit effort>`) as the joint's `simkit:effortLimit`, apart from the
 drive's `maxForce` (the servo's force, which simulators apply, unchanged), and the USD import
-reads the joint's effort from `simkit:effortLimit` where the joint carries it, else from
+reads the joint's effort from `simkit:effortLimit` where the joint carries it (and the drive's
+`maxForce` as the spec's `drive_peak_torque_at_joint`, the servo's force), else from
 `maxForce` (a converter's USD)."""
 
 from __future__ import annotations
@@ -66,30 +67,37 @@ def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"])
 """
 
 
-def _effort(tmp_path: Path, effort_line: str, meters: float = 1.0) -> float:
-    """The imported spec's effort_peak of the hinge (N m)."""
+def _hinge(tmp_path: Path, effort_line: str, meters: float = 1.0) -> dict:
+    """The imported spec's hinge joint."""
     usda = tmp_path / "bot.usda"
     usda.write_text(STAGE.format(meters=meters, effort=effort_line))
     done = import_robot(usda, tmp_path / "out")
     joints = {j["name"]: j for j in yaml.safe_load(done.spec_path.read_text())["joints"]}
-    return joints["hinge"]["effort_peak"]
+    return joints["hinge"]
 
 
 def test_reader_and_writer_agree_on_the_name() -> None:
     assert EFFORT_LIMIT == READ_EFFORT_LIMIT == "simkit:effortLimit"
 
 
-def test_effort_limit_is_the_effort(tmp_path) -> None:
-    assert _effort(tmp_path, "custom float simkit:effortLimit = 100") == 100
+def test_effort_limit_is_the_effort_and_max_force_the_servo(tmp_path) -> None:
+    hinge = _hinge(tmp_path, "custom float simkit:effortLimit = 100")
+    assert hinge["effort_peak"] == 100
+    assert hinge["drive_peak_torque_at_joint"] == pytest.approx(56.4)
 
 
 def test_without_it_max_force_is_the_effort(tmp_path) -> None:
-    assert _effort(tmp_path, "") == pytest.approx(56.4)
+    hinge = _hinge(tmp_path, "")
+    assert hinge["effort_peak"] == pytest.approx(56.4)
+    assert "drive_peak_torque_at_joint" not in hinge
 
 
 def test_effort_limit_in_stage_units(tmp_path) -> None:
-    """Like maxForce, in kilograms times stage units squared: 1e4 kg cm^2/s^2 is 1 N m."""
-    assert _effort(tmp_path, "custom float simkit:effortLimit = 1e6", 0.01) == pytest.approx(100)
+    """Like maxForce, in kilograms times stage units squared: 1e4 kg cm^2/s^2 is 1 N m (so
+    the 56.4 maxForce is 0.00564 N m here)."""
+    hinge = _hinge(tmp_path, "custom float simkit:effortLimit = 1e6", 0.01)
+    assert hinge["effort_peak"] == pytest.approx(100)
+    assert hinge["drive_peak_torque_at_joint"] == pytest.approx(0.00564)
 
 
 @pytest.mark.slow
@@ -108,5 +116,6 @@ def test_seed_kit_usd_carries_the_effort_limit(kit_factory, tmp_path) -> None:
         assert prim.GetAttribute(EFFORT_LIMIT).Get() == effort
         assert prim.GetAttribute("drive:angular:physics:maxForce").Get() == pytest.approx(56.4)
     done = import_robot(kit / "usd" / "ecn_2r.usda", tmp_path / "spec")
-    joints = yaml.safe_load(done.spec_path.read_text())["joints"]
-    assert {j["name"]: j.get("effort_peak") for j in joints if j["name"] in want} == want
+    joints = [j for j in yaml.safe_load(done.spec_path.read_text())["joints"] if j["name"] in want]
+    assert {j["name"]: j.get("effort_peak") for j in joints} == want
+    assert [j.get("drive_peak_torque_at_joint") for j in joints] == [56.4] * len(want)

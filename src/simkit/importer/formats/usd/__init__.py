@@ -9,6 +9,8 @@ composes (issue 39).
   body to the world; loop joints left out by the URDF repair `second_parents`;
 - `keep`: every layer as read, byte for byte (kept.py), the variant read in `source.args`,
   and the differences: the shared ones (formats/provenance.py) and the listed ones;
+- `EDITS`: a drive force apart from the joint's own effort limit kept as the spec's
+  `drive_peak_torque_at_joint` (carry_servos);
 - `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
   (fixups/falling.py), as an MJCF's is.
 """
@@ -52,6 +54,8 @@ class UsdSource(Source):
     files: dict[str, bytes] = field(default_factory=dict)
     variant: str | None = None
     listed: list[tuple[str, str]] = field(default_factory=list)
+    #: joint name -> the drive's force (N m or N) apart from its effort limit (tree.py)
+    servos: dict[str, float] = field(default_factory=dict)
 
 
 def read(shell: Source, options: ReadOptions) -> Source:
@@ -64,7 +68,7 @@ def read(shell: Source, options: ReadOptions) -> Source:
     source = UsdSource(shell.path, None, shell.packages, shell.report)
     source.scratch.append(scratch)
     try:
-        source.root, floating, listed, dropped = tree.to_tree(art, scratch)
+        source.root, floating, listed, dropped, source.servos = tree.to_tree(art, scratch)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
@@ -112,5 +116,21 @@ def mark_falling(draft) -> None:
     )
 
 
-EDITS = ()
+def carry_servos(draft) -> None:
+    """A joint whose USD carries its own effort limit (`simkit:effortLimit`, the spec's
+    effort_peak) and a drive `maxForce` apart from it (a simkit kit's servo force): the spec
+    keeps the force as `drive_peak_torque_at_joint` (the kit's servo force range), so both
+    come back as they were; a force equal to the limit adds nothing."""
+    servos = getattr(draft.source, "servos", {})
+    back = {new: old for old, new in draft.renames.get("joints", {}).items()}
+    for joint in draft.spec.get("joints", []):
+        force = servos.get(back.get(joint["name"], joint["name"]))
+        effort = joint.get("effort_peak")
+        if force is None or effort is None or abs(force - effort) <= 1e-9 * effort:
+            continue
+        joint["drive_peak_torque_at_joint"] = force
+        draft.changed()
+
+
+EDITS = (carry_servos,)
 AFTER = (mark_falling,)

@@ -5,7 +5,8 @@ Effort (N m for a revolute joint, N for a prismatic one): `simkit:effortLimit` w
 carries it (a simkit kit's USD writes the joint's own limit there, since UsdPhysics has no
 field for it; authored, it decides, 0 meaning none), else its drive's `maxForce` (the force
 a simulator lets the drive apply, the best a converter's USD offers). Both are in the stage's
-units: kilograms times metres (squared for a revolute joint) per unit.
+units: kilograms times metres (squared for a revolute joint) per unit. Where the joint carries
+both, the drive's `maxForce` is the servo's force (`servo_force`), kept apart from the limit.
 
 Speed (deg/s or m/s): PhysX's `maxJointVelocity` (per axis, else on PhysxJointAPI) or Newton's
 `velocityLimit`. A value that is not finite and positive (USD writes +-inf or FLT_MAX for
@@ -33,6 +34,19 @@ def effort(joint, kind: str, units: poses.Units) -> float | None:
     drive = "angular" if kind == "revolute" else "linear"
     own = poses.get(joint, EFFORT_LIMIT)
     force = _finite(own if own is not None else poses.get(joint, f"drive:{drive}:physics:maxForce"))
+    if force is None:
+        return None
+    return force * (units.kilograms * units.meters * (1 if kind == "prismatic" else units.meters))
+
+
+def servo_force(joint, kind: str, units: poses.Units) -> float | None:
+    """The drive's `maxForce` (N m or N) of a joint that carries its own effort limit too: the
+    servo's force apart from the limit (a simkit kit's USD), which the spec keeps as
+    `drive_peak_torque_at_joint`; None otherwise (the maxForce is then the effort)."""
+    if poses.get(joint, EFFORT_LIMIT) is None:
+        return None
+    drive = "angular" if kind == "revolute" else "linear"
+    force = _finite(poses.get(joint, f"drive:{drive}:physics:maxForce"))
     if force is None:
         return None
     return force * (units.kilograms * units.meters * (1 if kind == "prismatic" else units.meters))

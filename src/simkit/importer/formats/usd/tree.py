@@ -67,6 +67,8 @@ class Context:
     added: list[str] = field(default_factory=list)
     #: id(joint) -> its frame's turn in the child's body axes (the axis is turned by it)
     turns: dict[int, np.ndarray] = field(default_factory=dict)
+    #: joint name -> its drive's force (N m or N) where the joint has its own effort limit
+    servos: dict[str, float] = field(default_factory=dict)
 
 
 def unique_names(stage, paths: list[str]) -> dict[str, str]:
@@ -102,8 +104,9 @@ def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
     return poses.make(turn, at * ctx.units.meters)
 
 
-def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]:
-    """(`<robot>`, floating base, listed (what, reason), dropped (joint prim, why))."""
+def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list, dict]:
+    """(`<robot>`, floating base, listed (what, reason), dropped (joint prim, why), the
+    servo forces apart from the joints' effort limits {joint name: N m or N})."""
     from lxml import etree
     from pxr import UsdGeom
 
@@ -144,7 +147,7 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
             ctx.dropped.append((joint, "joins the robot to the world away from its root"))
     for element in robot.iter():
         element.sourceline = element.sourceline or 0
-    return robot, floating, ctx.listed, ctx.dropped
+    return robot, floating, ctx.listed, ctx.dropped, ctx.servos
 
 
 def _walk(art: Articulation, root: str, ctx: Context):
@@ -366,6 +369,9 @@ def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
     force = limits.effort(joint, kind, ctx.units)
     if force is not None:
         limit["effort"] = poses.fmt([force])
+    servo = limits.servo_force(joint, kind, ctx.units)
+    if servo is not None:
+        ctx.servos[element.get("name")] = servo
     speed = limits.velocity(joint, kind)
     if speed is not None:
         limit["velocity"] = poses.fmt([speed * scale])
