@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from simkit.check.source.usd import dynamics
+
 
 @dataclass
 class Body:
@@ -44,6 +46,8 @@ class Joint:
     limits: tuple[float, float] | None = None
     #: N m or N: `simkit:effortLimit` where authored, else the drive's force limit
     effort: float | None = None
+    #: {damping, friction, armature} where the source gives them (SI; dynamics.py)
+    dynamics: dict[str, float] = field(default_factory=dict)
     #: the joint's place in the stage's order (as authored: the order of a chain's joints)
     order: int = 0
 
@@ -170,6 +174,7 @@ def source_robot(path: Path, variant: str | None) -> Robot:
     every = Usd.PrimRange(stage.GetPseudoRoot(), Usd.TraverseInstanceProxies())
     authored = {str(p.GetPath()): i for i, p in enumerate(every)}
     robot = Robot()
+    more = None
     for at, label, d in sorted(joints):
         b0, b1 = str(d.body0), str(d.body1)
         joint = Joint(
@@ -182,6 +187,9 @@ def source_robot(path: Path, variant: str | None) -> Robot:
             joint.limits = _limits_of(d.limit, label, meters)
             lever = meters if label == "revolute" else 1.0
             joint.effort = _effort_of(stage.GetPrimAtPath(at), d.drive, kilograms * meters * lever)
+            more = dynamics.others(stage, variant) if more is None else more
+            prim = stage.GetPrimAtPath(at)
+            joint.dynamics = dynamics.of_joint(prim, label, kilograms, meters, more)
         joint.order = authored.get(at, 0)
         if not d.excludeFromArticulation:
             robot.joints[joint_names[at]] = joint
