@@ -97,7 +97,8 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
         why = " ".join(str(exc).split())[:200]
         return [require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
     allowed = Allowed.of(kit.doc)
-    joints = _joints(source, built, allowed) + _armatures(source, kit.joints, allowed)
+    declared = kit.doc.get("joints") or []  # robot.json's; none: no armature compared
+    joints = _joints(source, built, allowed) + _armatures(source, declared, allowed)
     out = unlisted_findings("source.joints", joints, _said(source, "joints"))
     out += unlisted_findings(
         "source.links", _bodies(source, built, allowed), _said(source, "links")
