@@ -1,10 +1,15 @@
 """A seed kit's own USD (its entry point, default physx variant) imports back to the kit's
 robot (issue 39): the imported kit passes its checks, its `source` findings (the USD proof,
 check/source/usd/) pass, and its URDF equals the original kit's URDF within the source
-check's tolerances (masses, CoMs, inertias, joint origins, axes, types and limits), but for
-the efforts (the USD's drive `maxForce` is the servo's, not the URDF's effort limit)."""
+check's tolerances (masses, CoMs, inertias, joint origins, axes, types and limits, efforts
+included: the USD carries the URDF's effort limit as `simkit:effortLimit`, apart from the
+drive's `maxForce`, the servo's 56.4 N m), and its joints' `<dynamics>` and armature equal the
+original's (MjcPhysics damping and friction loss from the `mujoco` variant, PhysX's armature).
+"""
 
 from __future__ import annotations
+
+import json
 
 import pytest
 
@@ -28,5 +33,17 @@ def test_ecn_2r_round_trip(kit_factory, tmp_path) -> None:
         load_urdf(result.kit_dir / "urdf" / "ecn_2r.urdf"),
         Allowed(),
     )
-    differ = [f.detail for f in findings if not f.ok and " effort " not in f.detail]
-    assert differ == []
+    assert [f.detail for f in findings if not f.ok] == []
+    assert _dynamics(original) == _dynamics(result.kit_dir)
+
+
+def _dynamics(kit) -> dict:
+    """Joint name -> (URDF damping, friction, robot.json armature)."""
+    doc = json.loads((kit / "robot.json").read_text())
+    armatures = {j["name"]: j.get("armature") for j in doc["joints"]}
+    out = {}
+    for joint in load_urdf(kit / "urdf" / "ecn_2r.urdf").joints:
+        d = joint.dynamics
+        values = (0.0, 0.0) if d is None else (float(d.damping or 0), float(d.friction or 0))
+        out[joint.name] = (*values, armatures.get(joint.name))
+    return out

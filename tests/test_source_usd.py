@@ -1,6 +1,6 @@
 """The USD source proof (check/source/usd/, issue 39) on a kit URDF written from the
 imported spec: it passes on the robot the stage describes, and fails, naming the link or
-joint, on a mass, a limit or a joint origin that differs."""
+joint, on a mass, a limit, an effort or a joint origin that differs."""
 
 from __future__ import annotations
 
@@ -34,7 +34,8 @@ def _urdf(spec: dict) -> str:
         limit = ""
         if "lower" in j:
             limit = (
-                f'<limit lower="{j["lower"]!r}" upper="{j["upper"]!r}" effort="1" velocity="1"/>'
+                f'<limit lower="{j["lower"]!r}" upper="{j["upper"]!r}"'
+                f' effort="{j.get("effort_peak", 1)!r}" velocity="1"/>'
             )
         out.append(
             f'<joint name="{j["name"]}" type="{j["type"]}"><parent link="{j["parent"]}"/>'
@@ -104,6 +105,16 @@ def test_limit_differs(tmp_path, imported) -> None:
 
     failed = [f.detail for f in _findings(tmp_path, imported, wider) if not f.ok]
     assert any("'shoulder': upper" in d for d in failed)
+
+
+def test_effort_differs(tmp_path, imported) -> None:
+    """The shoulder's drive maxForce (20 N m, no `simkit:effortLimit`) is its effort."""
+
+    def stronger(spec):
+        _by_name(spec["joints"])["shoulder"]["effort_peak"] = 20.1
+
+    failed = [f.detail for f in _findings(tmp_path, imported, stronger) if not f.ok]
+    assert any("'shoulder': effort 20 in the USD, 20.1 in the kit" in d for d in failed)
 
 
 def test_origin_differs(tmp_path, imported) -> None:

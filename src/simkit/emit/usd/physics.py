@@ -36,6 +36,13 @@ from simkit.model.inertia import principal_axes
 from simkit.model.kinematics import excluded_pairs, jointed_pairs, rpy_matrix
 from simkit.model.robot import Joint, Link, Loop, Robot
 
+#: the joint's effort limit (URDF `<limit effort>`), apart from the drive's maxForce
+EFFORT_LIMIT = "simkit:effortLimit"
+EFFORT_DOC = (
+    "The joint's effort limit (URDF limit effort): N m for a revolute joint, N for a"
+    " prismatic one. Not read by simulators: the drive's maxForce is the force they apply."
+)
+
 
 def _mass(prim, link: Link) -> None:
     from pxr import Gf, UsdPhysics
@@ -130,6 +137,7 @@ def _limits_and_drive(schema, robot: Robot, joint: Joint) -> None:
     for what in ("position", "velocity"):
         attr = prim.CreateAttribute(f"state:{kind}:physics:{what}", Sdf.ValueTypeNames.Float)
         attr.Set(0.0)
+    _effort_limit(prim, joint)
     actuator, target = next((a for a in robot.actuators if a.joint == joint.name), None), 0.0
     if actuator is None and joint.mimic is not None:
         if not driven_follower(robot, joint):
@@ -159,6 +167,22 @@ def _limits_and_drive(schema, robot: Robot, joint: Joint) -> None:
     if max_force is not None:
         drive.CreateMaxForceAttr(rounded(max_force))
     drive.CreateTargetPositionAttr(rounded(target))
+
+
+def _effort_limit(prim, joint: Joint) -> None:
+    """`simkit:effortLimit`: the joint's effort limit (the URDF `<limit effort>`, the spec's
+    effort_peak; N m or N, in the stage's units as the drive's maxForce). UsdPhysics, PhysX,
+    Isaac's robot schema and Newton's have no field for it (the drive's maxForce is the
+    servo's force, which simulators enforce; urdf-usd-converter's concept mapping lists the
+    effort as a gap), so it is a custom attribute that no simulator reads, and the USD
+    import reads the joint's effort from it."""
+    from pxr import Sdf
+
+    if joint.effort_peak is None:
+        return
+    attr = prim.CreateAttribute(EFFORT_LIMIT, Sdf.ValueTypeNames.Float, custom=True)
+    attr.SetDocumentation(EFFORT_DOC)
+    attr.Set(rounded(joint.effort_peak))
 
 
 def _filtered_pairs(stage, root: str, robot: Robot) -> None:

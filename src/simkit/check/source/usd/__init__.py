@@ -5,7 +5,14 @@ frames, axes and limits), not the importer's reader; the kit's URDF is read by y
 Compared, under the source's prim names (made unique in path order, renames from robot.json):
 
 - joint types (revolute, continuous for an unbounded revolute, prismatic, fixed; a
-  spherical joint as the kit's three revolute joints J_x, J_y, J) and limits (degrees to rad);
+  spherical joint as the kit's three revolute joints J_x, J_y, J), limits (degrees to rad)
+  and efforts (N m or N: `simkit:effortLimit` where the joint carries it, as a simkit kit's
+  USD does, else the drive's maxForce, as the import reads them; listed as
+  `joints.NAME.effort_peak` where the import estimated it), damping and friction loss
+  (MjcPhysics `mjc:damping`, `mjc:frictionloss`, read off the composed stage since the
+  parser has no field for them; other Physics variants fill what the read one lacks, as
+  the import reads them: stage.py, dynamics.py) against the kit URDF's `<dynamics>`, and
+  the armature against robot.json's;
 - every body's MassAPI mass (kg, <= 1e-6 relative), CoM and inertia in the body frame;
 - the pose of every body relative to the root body at 100 seeded configurations (1e-6 m,
   1e-6 in rotation): the source's composed from the parser's joint frames
@@ -90,9 +97,9 @@ def compare(kit: Kit, path: Path) -> list[Finding]:
         why = " ".join(str(exc).split())[:200]
         return [require("source.read", False, f"yourdfpy cannot read the kit: {why}")]
     allowed = Allowed.of(kit.doc)
-    out = unlisted_findings(
-        "source.joints", _joints(source, built, allowed), _said(source, "joints")
-    )
+    declared = kit.doc.get("joints") or []  # robot.json's; none: no armature compared
+    joints = _joints(source, built, allowed) + _armatures(source, declared, allowed)
+    out = unlisted_findings("source.joints", joints, _said(source, "joints"))
     out += unlisted_findings(
         "source.links", _bodies(source, built, allowed), _said(source, "links")
     )
@@ -164,7 +171,7 @@ def _joints(source: Robot, built, allowed: Allowed) -> list[str]:
             got = "spherical" if all(f.type in ("revolute", "continuous") for f in found) else "?"
         if want != got and f"{key}.type" not in allowed.keys:
             out.append(f"joint '{name}': {want} in the USD, {got} in the kit")
-        if want in ("revolute", "prismatic") and want == got:
+        if want in ("revolute", "prismatic", "continuous") and want == got:
             out += _limits(name, joint, found[0], allowed)
     return out
 
@@ -176,14 +183,54 @@ def _kit_type(joint) -> str:
 
 
 def _limits(name: str, joint, kit, allowed: Allowed) -> list[str]:
+    """lower and upper (rad or m; none for a continuous joint) and the effort."""
     out = []
     for i, attr in enumerate(("lower", "upper")):
-        if f"joints.{name}.{attr}" in allowed.keys:
+        if joint.limits is None or f"joints.{name}.{attr}" in allowed.keys:
             continue
         want = joint.limits[i]
         got = None if kit.limit is None else getattr(kit.limit, attr)
         if got is None or abs(float(got) - want) > REL * abs(want) + ABS_LENGTH:
             out.append(f"joint '{name}': {attr} {want:.9g} in the USD, {got} in the kit")
+    return out + _effort(name, joint, kit, allowed) + _dynamics(name, joint, kit, allowed)
+
+
+def _dynamics(name: str, joint, kit, allowed: Allowed) -> list[str]:
+    """The source's damping and friction loss (stage.py reads them off the stage: the parser
+    has no field for them) against the kit's URDF `<dynamics>`; 0 where either gives none."""
+    out = []
+    for key in ("damping", "friction"):
+        if f"joints.{name}.{key}" in allowed.keys or key not in joint.dynamics:
+            continue
+        want = joint.dynamics[key]
+        got = getattr(kit.dynamics, key, None) if kit.dynamics is not None else None
+        got = float(got or 0.0)
+        if abs(got - want) > REL * want + 1e-12:
+            out.append(f"joint '{name}': {key} {want:.9g} in the USD, {got:.9g} in the kit")
+    return out
+
+
+def _effort(name: str, joint, kit, allowed: Allowed) -> list[str]:
+    """The source's effort limit (N m or N, where it carries one) against the kit's."""
+    if joint.effort is None or f"joints.{name}.effort_peak" in allowed.keys:
+        return []
+    got = None if kit.limit is None else kit.limit.effort
+    if got is None or abs(float(got) - joint.effort) > REL * joint.effort:
+        return [f"joint '{name}': effort {joint.effort:.9g} in the USD, {got} in the kit"]
+    return []
+
+
+def _armatures(source: Robot, declared: list[dict], allowed: Allowed) -> list[str]:
+    """The source's armature (kg m^2 or kg, where it gives one) against robot.json's."""
+    kit = {j.get("name"): j.get("armature") for j in declared}
+    out = []
+    for name, joint in sorted(source.joints.items()):
+        want = joint.dynamics.get("armature")
+        if want is None or f"joints.{name}.armature" in allowed.keys:
+            continue
+        got = kit.get(_kit_name(allowed.joints, name))
+        if got is None or abs(float(got) - want) > REL * want:
+            out.append(f"joint '{name}': armature {want:.9g} in the USD, {got} in the kit")
     return out
 
 

@@ -1,8 +1,9 @@
 """Reading the USD source with usd-core's own UsdPhysics parser (`LoadUsdPhysicsFromRange`),
 not the importer's reader: the composed stage (with the import's variant) as a `Robot` of
 bodies (MassAPI mass kg, CoM m and inertia kg m^2 in the body frame) and joints (kind, the
-two bodies, their local frames in m, axis, limits in rad or m), its root body and the
-breadth-first tree, and `Robot.poses` (each body relative to the root body at joint values).
+two bodies, their local frames in m, axis, limits in rad or m, effort in N m or N), its root
+body and the breadth-first tree, and `Robot.poses` (each body relative to the root body at
+joint values).
 
 Frames: the kit's link frame of a body is its body frame moved (not turned) to the joint
 frame on it (importer/formats/usd/tree.py); `source_robot` finds that frame from the parser's
@@ -17,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from simkit.check.source.usd import dynamics
 
 
 @dataclass
@@ -41,6 +44,10 @@ class Joint:
     pose1: np.ndarray
     axis: int = 0
     limits: tuple[float, float] | None = None
+    #: N m or N: `simkit:effortLimit` where authored, else the drive's force limit
+    effort: float | None = None
+    #: {damping, friction, armature} where the source gives them (SI; dynamics.py)
+    dynamics: dict[str, float] = field(default_factory=dict)
     #: the joint's place in the stage's order (as authored: the order of a chain's joints)
     order: int = 0
 
@@ -167,6 +174,7 @@ def source_robot(path: Path, variant: str | None) -> Robot:
     every = Usd.PrimRange(stage.GetPseudoRoot(), Usd.TraverseInstanceProxies())
     authored = {str(p.GetPath()): i for i, p in enumerate(every)}
     robot = Robot()
+    more = None
     for at, label, d in sorted(joints):
         b0, b1 = str(d.body0), str(d.body1)
         joint = Joint(
@@ -177,6 +185,11 @@ def source_robot(path: Path, variant: str | None) -> Robot:
         if label in ("revolute", "prismatic"):
             joint.axis = "XYZ".index(str(d.axis).rsplit(".", 1)[-1][-1])
             joint.limits = _limits_of(d.limit, label, meters)
+            lever = meters if label == "revolute" else 1.0
+            joint.effort = _effort_of(stage.GetPrimAtPath(at), d.drive, kilograms * meters * lever)
+            more = dynamics.others(stage, variant) if more is None else more
+            prim = stage.GetPrimAtPath(at)
+            joint.dynamics = dynamics.of_joint(prim, label, kilograms, meters, more)
         joint.order = authored.get(at, 0)
         if not d.excludeFromArticulation:
             robot.joints[joint_names[at]] = joint
@@ -192,6 +205,21 @@ def _limits_of(limit, label: str, meters: float) -> tuple[float, float] | None:
     scale = math.radians(1.0) if label == "revolute" else meters
     low, high = (float(str(np.float32(v))) * scale for v in (limit.lower, limit.upper))
     return low, high
+
+
+def _effort_of(prim, drive, unit: float) -> float | None:
+    """The joint's effort limit (N m or N; `unit` the stage's force or torque unit in SI): the
+    kit's own `simkit:effortLimit` where authored (0: none), else the parser's drive force
+    limit; None where neither is finite and positive."""
+    from simkit.emit.usd.physics import EFFORT_LIMIT
+
+    attr = prim.GetAttribute(EFFORT_LIMIT) if prim else None
+    value = attr.Get() if attr else None
+    if value is None and drive is not None and drive.enabled:
+        value = drive.forceLimit
+    if value is None or not 0 < float(value) < 1e30:
+        return None
+    return float(str(np.float32(value))) * unit
 
 
 def _mass_of(prim, meters: float, kilograms: float) -> Body:

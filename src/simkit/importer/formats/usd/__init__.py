@@ -9,6 +9,9 @@ composes (issue 39).
   body to the world; loop joints left out by the URDF repair `second_parents`;
 - `keep`: every layer as read, byte for byte (kept.py), the variant read in `source.args`,
   and the differences: the shared ones (formats/provenance.py) and the listed ones;
+- `EDITS`: a drive force apart from the joint's own effort limit kept as the spec's
+  `drive_peak_torque_at_joint` (carry_servos); the armature the USD gives as the spec's
+  `armature` (carry_armatures; damping and friction travel as the URDF `<dynamics>`);
 - `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
   (fixups/falling.py), as an MJCF's is.
 """
@@ -52,6 +55,10 @@ class UsdSource(Source):
     files: dict[str, bytes] = field(default_factory=dict)
     variant: str | None = None
     listed: list[tuple[str, str]] = field(default_factory=list)
+    #: joint name -> the drive's force (N m or N) apart from its effort limit (tree.py)
+    servos: dict[str, float] = field(default_factory=dict)
+    #: joint name -> the armature the USD gives (kg m^2 or kg; formats/usd/dynamics.py)
+    armatures: dict[str, float] = field(default_factory=dict)
 
 
 def read(shell: Source, options: ReadOptions) -> Source:
@@ -60,14 +67,16 @@ def read(shell: Source, options: ReadOptions) -> Source:
     layers = confine.open_layers(shell.path, allowed)
     opened, variant = stage.open_stage(shell.path, layers.root, options.variant)
     art = stage.articulation(shell.path, opened)
+    art.variant = variant
     scratch = Path(tempfile.mkdtemp(prefix="simkit-usd-"))
     source = UsdSource(shell.path, None, shell.packages, shell.report)
     source.scratch.append(scratch)
     try:
-        source.root, floating, listed, dropped = tree.to_tree(art, scratch)
+        source.root, floating, listed, dropped, ctx = tree.to_tree(art, scratch)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
+    source.servos, source.armatures = ctx.servos, ctx.armatures
     source.packages.allow_read = (*source.packages.allow_read, scratch.resolve())
     source.files, source.variant, source.listed = layers.files, variant, listed
     for note in art.notes:
@@ -112,5 +121,34 @@ def mark_falling(draft) -> None:
     )
 
 
-EDITS = ()
+def carry_servos(draft) -> None:
+    """A joint whose USD carries its own effort limit (`simkit:effortLimit`, the spec's
+    effort_peak) and a drive `maxForce` apart from it (a simkit kit's servo force): the spec
+    keeps the force as `drive_peak_torque_at_joint` (the kit's servo force range), so both
+    come back as they were; a force equal to the limit adds nothing."""
+    servos = getattr(draft.source, "servos", {})
+    back = {new: old for old, new in draft.renames.get("joints", {}).items()}
+    for joint in draft.spec.get("joints", []):
+        force = servos.get(back.get(joint["name"], joint["name"]))
+        effort = joint.get("effort_peak")
+        if force is None or effort is None or abs(force - effort) <= 1e-9 * effort:
+            continue
+        joint["drive_peak_torque_at_joint"] = force
+        draft.changed()
+
+
+def carry_armatures(draft) -> None:
+    """A joint whose USD gives its armature (formats/usd/dynamics.py: MjcPhysics or PhysX)
+    keeps it as the spec's `armature` (kg m^2 or kg), so the import does not estimate it
+    (fixups/rotors.py skips a joint that has one)."""
+    armatures = getattr(draft.source, "armatures", {})
+    back = {new: old for old, new in draft.renames.get("joints", {}).items()}
+    for joint in draft.spec.get("joints", []):
+        value = armatures.get(back.get(joint["name"], joint["name"]))
+        if value is not None and "armature" not in joint:
+            joint["armature"] = value
+            draft.changed()
+
+
+EDITS = (carry_servos, carry_armatures)
 AFTER = (mark_falling,)

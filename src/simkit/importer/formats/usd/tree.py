@@ -12,10 +12,12 @@ stay. The source check
 (check/source/usd/) applies the same rule to usd-core's own physics parser.
 
 Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prismatic (m),
-Fixed, Spherical (the translation's three revolute joints); a drive's `maxForce` is the
-joint's effort, PhysX's `maxJointVelocity` or Newton's `velocityLimit` (deg/s) its
-velocity. A joint with no body0 (or a body0 that is no rigid body) joins the robot to the
-world: on the root body a fixed one bolts the base (a `world` link), another moves it.
+Fixed, Spherical (the translation's three revolute joints); effort and velocity as
+limits.py reads them (`simkit:effortLimit`, else the drive's `maxForce`; PhysX's
+`maxJointVelocity` or Newton's `velocityLimit`, deg/s); damping, friction loss and armature
+as dynamics.py reads them (MjcPhysics, PhysX's armature; other Physics variants fill gaps).
+A joint with no body0 (or a body0 that is no rigid body) joins the robot to the world: on
+the root body a fixed one bolts the base (a `world` link), another moves it.
 Other joint types are read as fixed and listed; a drive's stiffness and damping are not read
 (the kit sizes its own servos). A joint with `excludeFromArticulation`, or one closing a
 loop (a body's second parent joint, in the stage's order), is emitted after the tree, so the URDF
@@ -34,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.usd import poses, shapes
+from simkit.importer.formats.usd import dynamics, limits, poses, shapes
 from simkit.importer.formats.usd.stage import Articulation, ends
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
@@ -66,6 +68,12 @@ class Context:
     added: list[str] = field(default_factory=list)
     #: id(joint) -> its frame's turn in the child's body axes (the axis is turned by it)
     turns: dict[int, np.ndarray] = field(default_factory=dict)
+    #: joint name -> its drive's force (N m or N) where the joint has its own effort limit
+    servos: dict[str, float] = field(default_factory=dict)
+    #: joint name -> its armature (kg m^2 or kg) where the USD gives one (dynamics.py)
+    armatures: dict[str, float] = field(default_factory=dict)
+    #: the stage composed with each other Physics variant, made on first need (dynamics.py)
+    others: list | None = None
 
 
 def unique_names(stage, paths: list[str]) -> dict[str, str]:
@@ -101,8 +109,10 @@ def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
     return poses.make(turn, at * ctx.units.meters)
 
 
-def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]:
-    """(`<robot>`, floating base, listed (what, reason), dropped (joint prim, why))."""
+def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list, Context]:
+    """(`<robot>`, floating base, listed (what, reason), dropped (joint prim, why), the
+    context: its `servos`, the drive forces apart from the joints' effort limits, and
+    `armatures`, {joint name: N m or N, kg m^2 or kg})."""
     from lxml import etree
     from pxr import UsdGeom
 
@@ -143,7 +153,7 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
             ctx.dropped.append((joint, "joins the robot to the world away from its root"))
     for element in robot.iter():
         element.sourceline = element.sourceline or 0
-    return robot, floating, ctx.listed, ctx.dropped
+    return robot, floating, ctx.listed, ctx.dropped, ctx
 
 
 def _walk(art: Articulation, root: str, ctx: Context):
@@ -362,19 +372,25 @@ def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
         }
     elif kind == "revolute":
         element.set("type", "continuous")
-    drive = "angular" if kind == "revolute" else "linear"
-    force = poses.get(joint, f"drive:{drive}:physics:maxForce")
-    if force is not None and 0 < float(force) < UNBOUNDED:
-        unit = (
-            ctx.units.kilograms
-            * ctx.units.meters
-            * (1 if kind == "prismatic" else ctx.units.meters)
-        )
-        limit["effort"] = poses.fmt([float(force) * unit])
-    speed = poses.get(joint, f"physxJointAxis:{drive}:maxJointVelocity")
-    for other in ("physxJoint:maxJointVelocity", "newton:velocityLimit"):
-        speed = speed if speed is not None else poses.get(joint, other)
-    if speed is not None and 0 < float(speed) < UNBOUNDED:
-        limit["velocity"] = poses.fmt([float(speed) * scale])
+    force = limits.effort(joint, kind, ctx.units)
+    if force is not None:
+        limit["effort"] = poses.fmt([force])
+    servo = limits.servo_force(joint, kind, ctx.units)
+    if servo is not None:
+        ctx.servos[element.get("name")] = servo
+    speed = limits.velocity(joint, kind)
+    if speed is not None:
+        limit["velocity"] = poses.fmt([speed * scale])
     if limit:
         etree.SubElement(element, "limit", **limit)
+    _dynamics(element, joint, kind, ctx)
+
+
+def _dynamics(element, joint, kind: str, ctx: Context) -> None:
+    """`<dynamics>` and the armature (kept for the spec) as dynamics.py reads them."""
+    if ctx.others is None:
+        ctx.others = dynamics.variant_stages(ctx.art.stage, ctx.art.variant)
+    found = dynamics.of_joint(joint, kind, ctx.units, ctx.others)
+    if "armature" in found:
+        ctx.armatures[element.get("name")] = found["armature"]
+    dynamics.write(element, found)
