@@ -10,7 +10,7 @@ import yaml
 from tests.usd_stages import arm
 
 from simkit.importer import import_robot
-from simkit.importer.translate.links import MAX_GIVEN
+from simkit.importer.translate.links import MAX_GIVEN, MAX_GIVEN_PIECES
 
 pytest.importorskip("pxr")
 
@@ -34,8 +34,8 @@ def _mesh(stage, path: str, x: float, dent: bool):
     UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
 
 
-def _collision(tmp_path, grouped: bool = True, dent: bool = False) -> dict:
-    """The spec of `upper` in the test arm, given PIECES collision cube meshes: below one
+def _collision(tmp_path, grouped: bool = True, dent: bool = False, pieces: int = PIECES) -> dict:
+    """The spec of `upper` in the test arm, given `pieces` collision cube meshes: below one
     Xform (`grouped`) or right below the body; `dent`: the first one concave."""
     from pxr import Usd, UsdGeom
 
@@ -43,7 +43,7 @@ def _collision(tmp_path, grouped: bool = True, dent: bool = False) -> dict:
     stage = Usd.Stage.Open(str(path))
     parent = "/arm0/upper/split_hull" if grouped else "/arm0/upper"
     UsdGeom.Xform.Define(stage, parent)
-    for k in range(PIECES):
+    for k in range(pieces):
         _mesh(stage, f"{parent}/convex_{k}", 0.1 + 0.03 * k, dent and k == 0)
     stage.GetRootLayer().Save()
     done = import_robot(path, tmp_path / "out")
@@ -67,3 +67,8 @@ def test_meshes_right_below_the_body_are_sources_each(tmp_path) -> None:
 def test_a_concave_mesh_leaves_the_group_sources_each(tmp_path) -> None:
     """A group with a concave mesh is no convex decomposition: each mesh counts."""
     assert _collision(tmp_path, dent=True)["collision"] == "auto"
+
+
+def test_too_many_pieces_go_to_coacd(tmp_path) -> None:
+    """More pieces than the kit merges cheaply (quadratic in them): the CoACD path."""
+    assert _collision(tmp_path, pieces=MAX_GIVEN_PIECES + 1)["collision"] == "auto"

@@ -230,7 +230,8 @@ def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dic
 #: up to this many collision sources are kept as the link's pieces (one convex hull each)
 MAX_GIVEN = 10
 #: at most this many given pieces in all: the kit merges them pairwise down to its ten
-#: (derive/collision.py `merge_greedy`, quadratic in them: 48 pieces take about a second)
+#: (derive/collision.py `merge_greedy`, quadratic in them: 48 pieces took 7.5 s, cover
+#: included, where CoACD takes about 4 s a link); the spec allows 1000 (spec/bounds.py)
 MAX_GIVEN_PIECES = 64
 #: a `<collision>` attribute a reader sets on the convex pieces of one source (a USD's
 #: sibling collision meshes under one grouping prim: formats/usd/shapes.py), the same value

@@ -14,8 +14,10 @@ Scope), two or more and each convex, are the convex pieces of one source: a conv
 decomposition its author made, such as the URDF converter's prim for one `<collision>` mesh
 file holding many objects. Each stays its own piece, marked as of that source
 (translate/links.py `PIECE_OF`), so that they count once against the cap on given collision
-sources, as the URDF import counts that one file once. A mesh right below the body, or a
-sibling group with a concave mesh, counts as its own source.
+sources, as the URDF import counts that one file once (it reads the file as one shape, whose
+one convex hull the kit takes; here each piece keeps its own hull, merged pairwise down to
+the kit's ten). A mesh right below the body, or one of a group with a concave mesh, counts
+as its own source.
 """
 
 from __future__ import annotations
