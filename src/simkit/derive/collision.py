@@ -24,6 +24,7 @@ from dataclasses import asdict
 
 import numpy as np
 
+from simkit.derive.hulls import INSIDE_TOL, hull_points, qhull_mesh
 from simkit.errors import SpecError
 from simkit.model.hull import facet_depth, facet_planes, plane_max
 from simkit.model.hull import plane_values as hull_plane_values
@@ -51,7 +52,6 @@ COACD_PARAMS: dict[str, object] = {
 }
 COARSE_TOLERANCE = 0.0005  # m: manifold `simplify` tolerance for the coarse CoACD input
 COARSE_MAX_TRIANGLES = 5000  # issue 3: CoACD input of 2.5k to 5k triangles
-INSIDE_TOL = 1e-7  # m: a point this close to a hull's face counts as inside
 #: Runs of CoACD in this process, plus those reported back by pool workers (tests count them).
 COACD_RUNS = 0
 
@@ -75,8 +75,9 @@ def method_of(link: Link) -> str:
 
 #: Per-method result revisions, in the cache key only where a method's result changed, so
 #: the other methods' cached pieces (CoACD's, minutes a robot) stay valid. `mesh` 2: the hull
-#: became a piece (issue 25); before, no pieces.
-METHOD_REVISION = {"mesh": 2}
+#: became a piece (issue 25); before, no pieces. `coacd` and `given` 2: a hull holds every
+#: point it is made of (derive/hulls.py); before, a grown piece could drop a visual vertex.
+METHOD_REVISION = {"mesh": 2, "coacd": 2, "given": 2}
 
 
 def key_params(link: Link, seed: int) -> dict[str, object]:
@@ -111,9 +112,8 @@ def _manifold(mesh: Mesh):
 
 
 def _hull(points: np.ndarray):
-    import manifold3d as mf
-
-    return mf.Manifold.hull_points(np.asarray(points, dtype=np.float64))
+    """The points' convex hull, holding every one of them (derive/hulls.py)."""
+    return hull_points(points)
 
 
 def _union(parts: list):
@@ -142,20 +142,11 @@ def convex_mesh(solid) -> Mesh:
     the same piece's OBJ with other bytes."""
     mesh = _mesh(solid)
     hull = facet_planes(mesh.vertices)
-    planes = hull.equations
     samples = np.vstack([mesh.vertices, mesh.vertices[mesh.faces].mean(axis=1)])
     if -facet_depth(samples, hull, -CONVEX_EPS).min() <= CONVEX_EPS:
         return Mesh.of(mesh.vertices, canonical_triangles(mesh.faces))
-    keep = np.sort(hull.vertices)
-    index = np.full(len(mesh.vertices), -1, dtype=np.int64)
-    index[keep] = np.arange(len(keep))
-    faces = index[hull.simplices]
-    vertices = mesh.vertices[keep]
-    tri = vertices[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    flip = np.einsum("ij,ij->i", normal, planes[:, :3]) < 0
-    faces[flip] = faces[flip][:, ::-1]
-    return Mesh.of(vertices, canonical_triangles(faces))
+    outer = qhull_mesh(mesh.vertices, hull)
+    return Mesh.of(outer.vertices, canonical_triangles(outer.faces))
 
 
 # --- exact convex pieces -----------------------------------------------------------------

@@ -166,12 +166,12 @@ def link_spec(
             )
         if rgba is None and colour is not None:
             rgba = tuple(float(c) for c in colour)
-    collisions, infos = [], []
+    collisions, sources = [], []
     for element in link.findall("collision"):
         got = shape_of(source, element, writer, report, "collision")
         if got is not None:
             collisions.append(got[0])
-            infos.append(got[1])
+            sources.append(element.get(PIECE_OF) or f"#{len(sources)}")
     if points.grown(source, link, collisions, report):
         spec["estimated"] = [*spec.get("estimated", []), "collision_primitives"]
     solid = visuals
@@ -194,7 +194,7 @@ def link_spec(
     if rgba is not None:
         colours.setdefault(rgba, f"colour_{len(colours)}")
         spec["material"] = colours[rgba]
-    chosen = _collision(collisions, infos)
+    chosen = _collision(collisions, sources)
     if hull_collision and chosen["collision"] in ("given", "auto"):
         chosen = {"collision": "mesh"}
         report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
@@ -227,16 +227,26 @@ def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dic
     }
 
 
-#: up to this many collision elements are kept as the link's pieces (one convex hull each)
+#: up to this many collision sources are kept as the link's pieces (one convex hull each)
 MAX_GIVEN = 10
+#: at most this many given pieces in all: the kit merges them pairwise down to its ten
+#: (derive/collision.py `merge_greedy`, quadratic in them: 48 pieces took 7.5 s, cover
+#: included, where CoACD takes about 4 s a link); the spec allows 1000 (spec/bounds.py)
+MAX_GIVEN_PIECES = 64
+#: a `<collision>` attribute a reader sets on the convex pieces of one source (a USD's
+#: sibling collision meshes under one grouping prim: formats/usd/shapes.py), the same value
+#: on each: they count once against MAX_GIVEN. A URDF's elements never carry it.
+PIECE_OF = "simkit-piece-of"
 PRIMITIVES = {"box", "cylinder", "sphere", "capsule"}
 
 
-def _collision(collisions: list[dict], infos: list) -> dict:
-    """Primitives stay primitives; up to MAX_GIVEN meshes are kept, one convex piece each
-    (`given`); more go to the cached CoACD path (`auto`); none means no collision geometry."""
+def _collision(collisions: list[dict], sources: list[str]) -> dict:
+    """Primitives stay primitives; the meshes of up to MAX_GIVEN sources (`sources`: each
+    collision's source, PIECE_OF or its own), MAX_GIVEN_PIECES pieces in all, are kept, one
+    convex piece each (`given`); more go to the cached CoACD path (`auto`); none means no
+    collision geometry."""
     if all(c["shape"] in PRIMITIVES for c in collisions):
         return {"collision": "primitives", "collision_primitives": collisions}
-    if len(collisions) <= MAX_GIVEN:
+    if len(set(sources)) <= MAX_GIVEN and len(collisions) <= MAX_GIVEN_PIECES:
         return {"collision": "given", "collision_shapes": collisions}
     return {"collision": "auto"}

@@ -8,6 +8,16 @@ frame (metres, every transform and scale applied), triangulated as fans. A visua
 its bound material's UsdPreviewSurface `diffuseColor` (and `opacity`), else its
 `primvars:displayColor`. A mesh collider's `physics:approximation` is reported where it is
 not the mesh itself (the kit makes its own convex pieces).
+
+Collision meshes that are children of one prim other than the body (a grouping Xform or
+Scope), two or more and each convex, are the convex pieces of one source: a convex
+decomposition its author made, such as the URDF converter's prim for one `<collision>` mesh
+file holding many objects. Each stays its own piece, marked as of that source
+(translate/links.py `PIECE_OF`), so that they count once against the cap on given collision
+sources, as the URDF import counts that one file once (it reads the file as one shape, whose
+one convex hull the kit takes; here each piece keeps its own hull, merged pairwise down to
+the kit's ten). A mesh right below the body, or one of a group with a concave mesh, counts
+as its own source.
 """
 
 from __future__ import annotations
@@ -18,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from simkit.importer.formats.usd import poses
+from simkit.importer.translate.links import PIECE_OF
 
 SHAPES = ("Cube", "Sphere", "Capsule", "Cylinder", "Mesh")
 #: attributes on a `<collision>` holding its shape's MassAPI density and mass until mass.py
@@ -46,6 +57,7 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
 
     notes = []
     to_link = poses.inv(frame)
+    meshes: dict[str, list] = {}  # parent prim path -> the collision mesh elements below it
     for prim in prims_of(body, bodies):
         full = poses.relative(ctx.cache, prim, body, ctx.units.meters)
         full = to_link @ full
@@ -59,6 +71,8 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
             element = _element(link, "collision", prim, full, ctx)
             if element is not None and prim.HasAPI(UsdPhysics.MassAPI):
                 _own_mass(element, UsdPhysics.MassAPI(prim), ctx.units)
+            if element is not None and prim.GetTypeName() == "Mesh":
+                meshes.setdefault(str(prim.GetParent().GetPath()), []).append(element)
             if prim.HasAPI(UsdPhysics.MeshCollisionAPI):
                 how = UsdPhysics.MeshCollisionAPI(prim).GetApproximationAttr().Get()
                 notes.append(str(how or "none"))
@@ -66,7 +80,25 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
             element = _element(link, "visual", prim, full, ctx)
             if element is not None:
                 _colour(element, prim)
+    meshes.pop(str(body.GetPath()), None)
+    for parent, elements in sorted(meshes.items()):
+        _pieces(parent, elements)
     return notes
+
+
+def _pieces(parent: str, elements: list) -> None:
+    """Mark the collision meshes below one grouping prim `parent` as the pieces of one
+    source (module docstring) where there are two or more and each is convex."""
+    import trimesh
+
+    if len(elements) < 2:
+        return
+    for element in elements:
+        path = element.find("geometry/mesh").get("filename")
+        if not trimesh.load_mesh(path, file_type="stl").is_convex:
+            return
+    for element in elements:
+        element.set(PIECE_OF, parent)
 
 
 def _own_mass(element, api, units) -> None:
