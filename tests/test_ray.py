@@ -22,6 +22,9 @@ from simkit.pipeline import build
 
 ray = pytest.importorskip("ray")
 psutil = pytest.importorskip("psutil")
+#: one pytest-xdist worker runs every test that starts Ray (tests/conftest.py), so two local
+#: Ray instances never share the cores while these kill and retry workers
+pytestmark = pytest.mark.xdist_group("ray")
 
 SPECS = Path(__file__).resolve().parent / "specs"
 #: Two small specs: one of primitives, one naming a mesh file the task must carry along.
