@@ -5,6 +5,9 @@ Tests must not modify a shared kit; copy it (`shutil.copytree`) first if they ne
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -66,6 +69,11 @@ def spec_variant(tmp_path_factory):
     return get
 
 
+#: XLA flags for the tests that compile an MJX rollout on the CPU and run it for a few steps:
+#: compiling is their time, and these cut it to about half with the same numbers (see
+#: scripts/bench_gpu.py's PROBE_XLA_FLAGS, which its --probe sets itself).
+XLA_COMPILE_FLAGS = "--xla_backend_optimization_level=0 --xla_cpu_use_fusion_emitters=false"
+
 #: The five seed robots (robots/*.yaml).
 SEED_ROBOTS = ("asimov", "ecn_2r", "rosie_1000", "rosie_1400", "rosie_600")
 
@@ -74,6 +82,24 @@ SEED_ROBOTS = ("asimov", "ecn_2r", "rosie_1000", "rosie_1400", "rosie_600")
 def seed_kits(kit_factory) -> dict[str, BuildResult]:
     """Every seed robot's kit, built once per session (shared with `kit_factory`)."""
     return {name: kit_factory(name) for name in SEED_ROBOTS}
+
+
+@pytest.fixture(scope="session")
+def ecn_2r_mjx_demo(kit_factory) -> subprocess.CompletedProcess:
+    """One run of ecn_2r's examples/mjx_demo.py (3 worlds, 5 steps), from inside its kit,
+    with XLA_COMPILE_FLAGS: the tests of the demo's output share it, as each run compiles its
+    rollout anew (25 to 30 s on a 2-core CPU with XLA's defaults). Tests using it carry
+    `xdist_group("mjx_demo")`, so one pytest-xdist worker runs it once."""
+    flags = f"{XLA_COMPILE_FLAGS} {os.environ.get('XLA_FLAGS', '')}"
+    return subprocess.run(
+        [sys.executable, "examples/mjx_demo.py", "--batch", "3", "--steps", "5"],
+        cwd=kit_factory("ecn_2r").kit_dir,
+        env={**os.environ, "XLA_FLAGS": flags},
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
 
 
 def pytest_addoption(parser):
@@ -85,12 +111,27 @@ def pytest_addoption(parser):
 
 
 #: Fixtures that build (and check) real kits: a test using any of them is in the slow tier.
-KIT_FIXTURES = {"kit_factory", "rosie_1000", "rosie_1000_published", "seed_kits", "spec_variant"}
+KIT_FIXTURES = {
+    "ecn_2r_mjx_demo",
+    "kit_factory",
+    "rosie_1000",
+    "rosie_1000_published",
+    "seed_kits",
+    "spec_variant",
+}
 
 
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups (--dist loadgroup)
 def pytest_collection_modifyitems(config, items):
     """Mark kit-building tests `slow`, so `pytest -m "not slow"` is the fast unit tier. Tests
-    that build without these fixtures carry an explicit `@pytest.mark.slow`."""
+    that build without these fixtures carry an explicit `@pytest.mark.slow`.
+
+    Under pytest-xdist (`-n`, pyproject's addopts) each test file is one group, run whole by
+    one worker, so a module-scoped fixture (a probe subprocess, a kit import) is computed
+    once and not once per worker; a test that names its own `xdist_group` (Ray's, the MJX
+    demo's) joins that group instead."""
     for item in items:
         if KIT_FIXTURES & set(getattr(item, "fixturenames", ())):
             item.add_marker(pytest.mark.slow)
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(item.path.name))

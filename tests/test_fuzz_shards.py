@@ -41,6 +41,7 @@ def _outcomes(work: Path) -> dict[int, str]:
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("ray")  # with tests/test_ray.py: one local Ray instance at a time
 def test_ray_shards_give_the_serial_table(tmp_path):
     pytest.importorskip("ray")
     serial = _run(tmp_path / "serial", "--count", "30", "--shard-size", "4")

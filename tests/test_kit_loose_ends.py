@@ -9,8 +9,6 @@ import ast
 import importlib.util
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -121,14 +119,9 @@ def test_the_mjx_demo_says_the_first_call_compiles_before_making_it(seed_kits):
 
 @NEEDS_MJX
 @pytest.mark.slow
-def test_the_mjx_demo_prints_its_progress_in_order(seed_kits):
-    done = subprocess.run(
-        [sys.executable, "examples/mjx_demo.py", "--batch", "2", "--steps", "2"],
-        cwd=seed_kits["ecn_2r"].kit_dir,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
+@pytest.mark.xdist_group("mjx_demo")
+def test_the_mjx_demo_prints_its_progress_in_order(ecn_2r_mjx_demo):
+    done = ecn_2r_mjx_demo  # ecn_2r's demo, run from inside its kit
     assert done.returncode == 0, done.stderr[-2000:]
     lines = done.stdout.splitlines()
     compiling = next(i for i, s in enumerate(lines) if s.startswith("compiling the rollout"))

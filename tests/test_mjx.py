@@ -132,18 +132,11 @@ def test_a_broad_phase_that_drops_touching_pairs_fails(seed_kits, tmp_path):
 
 
 @needs_mjx
-def test_the_kit_mjx_demo_runs(seed_kits):
+@pytest.mark.xdist_group("mjx_demo")
+def test_the_kit_mjx_demo_runs(ecn_2r_mjx_demo):
     """examples/mjx_demo.py, the document's snippet made runnable, with the batch size as an
-    argument: it steps the batch and reports no NaN."""
-    kit = seed_kits["ecn_2r"].kit_dir
-    done = subprocess.run(
-        [sys.executable, "examples/mjx_demo.py", "--batch", "3", "--steps", "5"],
-        cwd=kit,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
+    argument (`--batch 3 --steps 5`): it steps the batch and reports no NaN."""
+    done = ecn_2r_mjx_demo
     assert done.returncode == 0, done.stderr[-2000:]
     assert "worlds: 3, steps: 5" in done.stdout and "any NaN: False" in done.stdout, done.stdout
 

@@ -22,6 +22,9 @@ from simkit.pipeline import build
 
 ray = pytest.importorskip("ray")
 psutil = pytest.importorskip("psutil")
+#: one pytest-xdist worker runs every test that starts Ray (tests/conftest.py), so two local
+#: Ray instances never share the cores while these kill and retry workers
+pytestmark = pytest.mark.xdist_group("ray")
 
 SPECS = Path(__file__).resolve().parent / "specs"
 #: Two small specs: one of primitives, one naming a mesh file the task must carry along.
@@ -101,9 +104,12 @@ def _running_task(proc) -> bool:
 
 
 def _kill_task_workers(stop: threading.Event, kills: list[int], most: int) -> None:
-    """Kill -9 every Ray worker process that is running `run_job`, up to `most` times."""
+    """Kill -9 every Ray worker process that is running `run_job`, up to `most` times (a sweep
+    stops at `most`: a STEP child the killed worker forked, orphaned, looks like a task)."""
     while not stop.is_set() and len(kills) < most:
         for proc in psutil.process_iter(["pid"]):
+            if len(kills) >= most:
+                break
             if _running_task(proc) and proc.info["pid"] not in kills:
                 try:
                     proc.kill()
