@@ -46,6 +46,12 @@ sys.path.insert(0, str(REPO / "src"))
 VENV = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "simkit-ci/venv-usdconv"
 SEEDS = 20
 TOL = 1e-6
+#: |limit| (rad or m) from which an original's joint limit is no limit: SDFormat's default
+#: limit is +-1e16 and URDFs made from SDF (a multirotor's rotors) carry it. At the spec's
+#: fastest joint (200 rad/s) 1e15 rad takes 160,000 years: no motion ever reaches it, so
+#: such a revolute joint moves as a continuous one and is compared as one (simkit's own URDF
+#: and SDF imports read it so too). A limit of a few turns (a cable's) stays a limit.
+NO_LIMIT = 1e15
 
 
 def robots(root: Path, mjcf: bool, only: list[str], exclude: list[str]) -> list[Path]:
@@ -113,19 +119,20 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
     conv, out = work / slug / "usd", work / slug / "spec"
     name = f"r_{slug[-40:]}".strip("_")
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
-    if not (args.reuse and (out / f"{name}.yaml").is_file()):
+    usdas = sorted(conv.glob("*.usda")) if args.reuse and conv.is_dir() else []
+    if not usdas:
         tool = "mujoco_usd_converter" if args.mjcf else "urdf_usd_converter"
         code, text = _run([str(venv_dir(args) / "bin" / tool), str(path), str(conv)], args.timeout)
         usdas = sorted(conv.glob("*.usda")) if conv.is_dir() else []
         if code or not usdas:
             row["why"] = _last(text) or "no USD written"
             return row
-        row["step"] = "import"
-        cmd = [sys.executable, "-m", "simkit.cli", "import", str(usdas[0]), "--out", str(out)]
-        code, text = _run([*cmd, "--name", name, "-q"], args.timeout, env)
-        if code:
-            row["why"] = _last(text)
-            return row
+    row["step"] = "import"  # always with this code: a reused USD is imported again
+    cmd = [sys.executable, "-m", "simkit.cli", "import", str(usdas[0]), "--out", str(out)]
+    code, text = _run([*cmd, "--name", name, "-q"], args.timeout, env)
+    if code:
+        row["why"] = _last(text)
+        return row
     row["step"] = "compare"
     spec = yaml.safe_load((out / f"{name}.yaml").read_text())
     try:
@@ -139,8 +146,9 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
         row["step"] = "build"
         cmd = [sys.executable, "-m", "simkit.cli", "build", str(out / f"{name}.yaml")]
         code, text = _run([*cmd, "--out", str(work / slug / "kits")], args.timeout, env)
+        (work / slug / "build.log").write_text(text + "\n")
         if code:
-            row["why"] = _last(text)
+            row["why"] = _failed(text)
             return row
     row["ok"] = True
     return row
@@ -149,6 +157,15 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
 def venv_dir(args) -> Path:
     """The converters' venv."""
     return Path(args.venv)
+
+
+def _failed(text: str) -> str:
+    """A failed build's checks: the failing checks' names, then the first one's line."""
+    fails = [line.strip() for line in text.splitlines() if line.strip().startswith("FAIL ")]
+    if not fails:
+        return _last(text)
+    names = ", ".join(sorted({line.split()[1].rstrip(":") for line in fails}))
+    return f"{names}: {fails[0]}"[:300].replace("|", "/")
 
 
 def _last(text: str) -> str:
@@ -338,6 +355,15 @@ def _compare_bodies(
     return out
 
 
+def _unlimited(kind: str, limits: tuple | None) -> tuple[str, tuple | None]:
+    """(type, limits) of an original joint as it moves: a limit at or beyond NO_LIMIT is
+    none, and a revolute joint with such a limit is continuous. (A URDF revolute without
+    lower/upper is not: its limits default to 0, which the import estimates.)"""
+    if limits is None or max(map(abs, limits)) < NO_LIMIT:
+        return kind, limits
+    return ("continuous" if kind == "revolute" else kind), None
+
+
 def compare_urdf(path: Path, spec: dict) -> list[str]:
     """The spec against the original URDF (yourdfpy)."""
     import tempfile
@@ -360,7 +386,7 @@ def compare_urdf(path: Path, spec: dict) -> list[str]:
             limits = None
             if j.type != "continuous" and lim is not None and lim.lower is not None:
                 limits = (float(lim.lower), float(lim.upper))
-            joints[j.name] = (j.type, limits)
+            joints[j.name] = _unlimited(j.type, limits)
     children = {j.child for j in robot.joints}
     root = next(link.name for link in robot.links if link.name not in children)
     kit_root = kit.name("links", root)
@@ -435,7 +461,7 @@ def compare_mjcf(path: Path, spec: dict) -> list[str]:
             limits = tuple(float(v) for v in model.jnt_range[j]) if model.jnt_limited[j] else None
             if kind == "revolute" and limits is None:
                 kind = "continuous"
-            joints[model.joint(j).name or f"jnt{j}"] = (kind, limits)
+            joints[model.joint(j).name or f"jnt{j}"] = _unlimited(kind, limits)
     kit_root = kit.name("links", name[top])
 
     def poses_fn(rng):
@@ -530,7 +556,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("/tmp/simkit-usd-corpus"))
     parser.add_argument("--build", action="store_true", help="also build each spec")
     parser.add_argument(
-        "--reuse", action="store_true", help="compare again the specs an earlier run imported"
+        "--reuse", action="store_true", help="reuse the USD an earlier run converted"
     )
     parser.add_argument("--limit", type=int, default=0)
     parser.add_argument("--timeout", type=float, default=600.0)
