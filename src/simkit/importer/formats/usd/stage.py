@@ -34,6 +34,9 @@ class Articulation:
     #: further root bodies, each bolted to the world like the first (several articulations
     #: of one robot: urdf-usd-converter writes one per child of a massless root link)
     more_roots: list[str] = field(default_factory=list)
+    #: (kind, prim paths) left out as the scene's, not the robot's: "links" (rigid bodies not
+    #: joined to it), "joints" (joints touching none of its bodies)
+    apart: dict[str, list[str]] = field(default_factory=dict)
 
 
 def open_stage(path: Path, root_layer, variant: str | None):
@@ -102,6 +105,8 @@ def articulation(path: Path, stage) -> Articulation:
     touching = [j for j in linking if {t for t in _ends(j) if t} & found]
     out = Articulation(stage, stage.GetPrimAtPath(root), sorted(found), touching, notes=notes)
     out.more_roots = held[1:]
+    away = [str(j.GetPath()) for j in joints if not {t for t in _ends(j) if t} & found]
+    out.apart = {"links": sorted(apart), "joints": sorted(away)}
     return out
 
 

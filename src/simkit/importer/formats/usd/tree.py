@@ -23,7 +23,8 @@ repair `second_parents` leaves it out (listed as dropped).
 
 Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
 frame; where the mass is not authored, the collision shapes' solid at the MassAPI `density`
-(else 1000 kg/m^3, UsdPhysics' default), its CoM and inertia where those are not authored.
+(else 1000 kg/m^3, UsdPhysics' default), its CoM and inertia where those are not authored;
+all scaled to MjcPhysics' `setTotalMass` where the stage sets it (mjc.py).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.usd import poses, shapes
+from simkit.importer.formats.usd import mjc, poses, shapes
 from simkit.importer.formats.usd.stage import Articulation, ends
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
@@ -124,6 +125,8 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     for body in art.bodies:
         if body in frames:
             _link(robot, body, frames[body], ctx)
+    mjc.scale_to_total(robot, art, ctx.units.kilograms, ctx.listed)
+    _list_apart(art, ctx)
     for name in ctx.added:
         etree.SubElement(robot, "link", name=name)
     for joint, parent, child, flip, origin in order:
@@ -144,6 +147,21 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     for element in robot.iter():
         element.sourceline = element.sourceline or 0
     return robot, floating, ctx.listed, ctx.dropped
+
+
+def _list_apart(art: Articulation, ctx: Context) -> None:
+    """List each body and joint of the scene left out (a manipulated object on its own joints
+    to the world), named as among all of the stage's (the source check reads the whole
+    stage with usd-core's parser, and names them so)."""
+    from pxr import Usd, UsdPhysics
+
+    every = list(Usd.PrimRange(art.stage.GetPseudoRoot(), Usd.TraverseInstanceProxies()))
+    for kind, test in (("links", lambda p: p.HasAPI(UsdPhysics.RigidBodyAPI)),
+                       ("joints", lambda p: p.IsA(UsdPhysics.Joint))):  # fmt: skip
+        names = unique_names(art.stage, [str(p.GetPath()) for p in every if test(p)])
+        for path in art.apart.get(kind, []):
+            why = "the scene's, not joined to the robot: not imported"
+            ctx.listed.append((f"{kind}.{names[path]}", why))
 
 
 def _walk(art: Articulation, root: str, ctx: Context):

@@ -1,0 +1,33 @@
+"""A USD scene that holds the robot and an object on its own joints to the world (a
+manipulation task's pen): the object's body and joints are left out and each listed in
+`source_differences`, so the build's source check, which reads the whole stage, accepts
+them as the import's listed differences."""
+
+from __future__ import annotations
+
+import pytest
+import yaml
+from tests.usd_stages import arm
+
+from simkit.importer import import_robot
+
+pytest.importorskip("pxr")
+
+
+def test_scene_object_listed(tmp_path) -> None:
+    """`ball` on a prismatic joint `ball_slide` from the world: not imported, both listed."""
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    ball = UsdGeom.Xform.Define(stage, "/ball")
+    UsdPhysics.RigidBodyAPI.Apply(ball.GetPrim())
+    slide = UsdPhysics.PrismaticJoint.Define(stage, "/ball/ball_slide")
+    slide.CreateBody1Rel().SetTargets([ball.GetPath()])
+    slide.CreateAxisAttr("X")
+    stage.GetRootLayer().Save()
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    assert "ball" not in {link["name"] for link in spec["links"]}
+    listed = {item["what"] for item in spec["source_differences"]}
+    assert {"links.ball", "joints.ball_slide"} <= listed
+    assert "joints.shoulder" not in listed
