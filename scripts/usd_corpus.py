@@ -21,7 +21,9 @@ compiled by MuJoCo (MJCF), independently of both converter and importer:
   at rest), every massive body's centre of mass (1e-6 m) and inertia tensor in the root
   body's frame: quantities that do not depend on where a format puts its link frames.
 
-With `--build` each spec is also built (`simkit build`, its checks). A row: the robot file,
+With `--reuse` a USD an earlier run converted is not converted again (it is imported again,
+by this code). With `--build` each spec is also built (`simkit build`, its checks; the log in
+OUT/ROBOT/build.log, a failing build's row names its failing checks). A row: the robot file,
 the step reached (convert, import, compare, build), the result and the first difference.
 The table goes into docs/import-corpus.md under its title. No robot is named here.
 """
@@ -511,7 +513,14 @@ def table(rows: list[dict], title: str, command: str) -> str:
     converted = [r for r in rows if r["step"] != "convert"]
     refused = [r for r in converted if r["step"] == "import" and _refusal(r["why"])]
     robots = len(converted) - len(refused)
-    share = f"{100.0 * good / robots:.1f} %" if robots else "-"
+    equal = sum(r["ok"] or r["step"] == "build" for r in rows)  # compared equal, then built
+
+    def share(n: int) -> str:
+        return f"{100.0 * n / robots:.1f} %" if robots else "-"
+
+    said = f"of the other {robots}, {equal} give a robot equal to the original ({share(equal)})"
+    if any(r["step"] == "build" for r in rows):
+        said += f" and {good} of those a checked kit (the build; {share(good)})"
     lines = [
         f"## {title}",
         "",
@@ -519,7 +528,7 @@ def table(rows: list[dict], title: str, command: str) -> str:
         "",
         f"{len(rows)} files: {len(rows) - len(converted)} not converted by the converter, "
         f"{len(refused)} refused in one line by the import (several robots, no articulation); "
-        f"of the other {robots}, {good} give a robot equal to the original ({share}).",
+        f"{said}.",
         "",
         "| file | result | step | first difference or error |",
         "|---|---|---|---|",
