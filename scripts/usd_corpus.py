@@ -16,7 +16,8 @@ compiled by MuJoCo (MJCF), independently of both converter and importer:
   name (names made USD identifiers, as the converters make them; renames from the spec's
   `source_differences`); a value the import estimated (the spec's `estimated`: a zero
   inertia, a missing limit) is the import's, as for a URDF import, and not compared;
-- each original movable joint: its type (revolute, continuous, prismatic) and limits;
+- each original movable joint: its type (revolute, continuous, prismatic) and limits (a
+  limit of 1e15 or more is none, `NO_LIMIT`: a revolute joint with it is continuous);
 - at 20 seeded configurations (hinge and slide joints in their limits, balls and free joints
   at rest), every massive body's centre of mass (1e-6 m) and inertia tensor in the root
   body's frame: quantities that do not depend on where a format puts its link frames.
