@@ -31,3 +31,21 @@ def test_scene_object_listed(tmp_path) -> None:
     listed = {item["what"] for item in spec["source_differences"]}
     assert {"links.ball", "joints.ball_slide"} <= listed
     assert "joints.shoulder" not in listed
+
+
+def test_names_as_in_the_whole_stage(tmp_path) -> None:
+    """The object's joint `/a_ball/shoulder` comes first in path order: it is `shoulder`,
+    the robot's is `shoulder_1`, as usd-core's parser names them for the source check."""
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    ball = UsdGeom.Xform.Define(stage, "/a_ball")
+    UsdPhysics.RigidBodyAPI.Apply(ball.GetPrim())
+    twist = UsdPhysics.RevoluteJoint.Define(stage, "/a_ball/shoulder")
+    twist.CreateBody1Rel().SetTargets([ball.GetPath()])
+    stage.GetRootLayer().Save()
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    joints = {joint["name"]: joint for joint in spec["joints"]}
+    assert joints["shoulder_1"]["parent"] == "base" and "shoulder" not in joints
+    assert "joints.shoulder" in {item["what"] for item in spec["source_differences"]}

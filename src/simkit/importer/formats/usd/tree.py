@@ -108,8 +108,9 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     from pxr import UsdGeom
 
     ctx = Context(art, poses.Units.of(art.stage), UsdGeom.XformCache(), scratch)
-    ctx.names = unique_names(art.stage, art.bodies)
-    joint_names = unique_names(art.stage, [str(j.GetPath()) for j in art.joints])
+    every = _stage_names(art.stage)
+    ctx.names = {body: every["links"][body] for body in art.bodies}
+    joint_names = every["joints"]
     robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
     robot.sourceline = 0
     root = str(art.root_prim.GetPath())
@@ -126,7 +127,10 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
         if body in frames:
             _link(robot, body, frames[body], ctx)
     mjc.scale_to_total(robot, art, ctx.units.kilograms, ctx.listed)
-    _list_apart(art, ctx)
+    for kind in ("links", "joints"):
+        for path in art.apart.get(kind, []):
+            why = "the scene's, not joined to the robot: not imported"
+            ctx.listed.append((f"{kind}.{every[kind][path]}", why))
     for name in ctx.added:
         etree.SubElement(robot, "link", name=name)
     for joint, parent, child, flip, origin in order:
@@ -149,19 +153,17 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     return robot, floating, ctx.listed, ctx.dropped
 
 
-def _list_apart(art: Articulation, ctx: Context) -> None:
-    """List each body and joint of the scene left out (a manipulated object on its own joints
-    to the world), named as among all of the stage's (the source check reads the whole
-    stage with usd-core's parser, and names them so)."""
+def _stage_names(stage) -> dict[str, dict[str, str]]:
+    """{"links": rigid body path -> name, "joints": joint path -> name} over the whole stage
+    (unique_names): a robot's names do not depend on the scene around it being left out,
+    and are those the source check (check/source/usd/), which reads the whole stage, gives."""
     from pxr import Usd, UsdPhysics
 
-    every = list(Usd.PrimRange(art.stage.GetPseudoRoot(), Usd.TraverseInstanceProxies()))
-    for kind, test in (("links", lambda p: p.HasAPI(UsdPhysics.RigidBodyAPI)),
-                       ("joints", lambda p: p.IsA(UsdPhysics.Joint))):  # fmt: skip
-        names = unique_names(art.stage, [str(p.GetPath()) for p in every if test(p)])
-        for path in art.apart.get(kind, []):
-            why = "the scene's, not joined to the robot: not imported"
-            ctx.listed.append((f"{kind}.{names[path]}", why))
+    every = Usd.TraverseInstanceProxies(Usd.PrimAllPrimsPredicate)
+    prims = list(Usd.PrimRange(stage.GetPseudoRoot(), every))
+    bodies = [str(p.GetPath()) for p in prims if p.HasAPI(UsdPhysics.RigidBodyAPI)]
+    joints = [str(p.GetPath()) for p in prims if p.IsA(UsdPhysics.Joint) and p.IsActive()]
+    return {"links": unique_names(stage, bodies), "joints": unique_names(stage, joints)}
 
 
 def _walk(art: Articulation, root: str, ctx: Context):
