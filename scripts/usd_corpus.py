@@ -36,6 +36,7 @@ import fnmatch
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -128,6 +129,7 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
         code, text = _run([str(venv_dir(args) / "bin" / tool), str(path), str(conv)], args.timeout)
         usdas = sorted(conv.glob("*.usda")) if conv.is_dir() else []
         if code or not usdas:
+            shutil.rmtree(conv, ignore_errors=True)  # a failed conversion's part: not reused
             row["why"] = _last(text) or "no USD written"
             return row
     row["step"] = "import"  # always with this code: a reused USD is imported again
