@@ -49,3 +49,26 @@ def test_names_as_in_the_whole_stage(tmp_path) -> None:
     joints = {joint["name"]: joint for joint in spec["joints"]}
     assert joints["shoulder_1"]["parent"] == "base" and "shoulder" not in joints
     assert "joints.shoulder" in {item["what"] for item in spec["source_differences"]}
+
+
+def test_welded_target_listed(tmp_path) -> None:
+    """A MuJoCo mocap body as mujoco-usd-converter writes it: `target`, bolted to the world
+    (`target_bolt`) and welded to `upper` by a joint excluded from the articulation: the
+    tree does not reach it; both it and its bolt are listed, not imported."""
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    path = arm(tmp_path / "arm.usda")
+    stage = Usd.Stage.Open(str(path))
+    target = UsdGeom.Xform.Define(stage, "/target")
+    UsdPhysics.RigidBodyAPI.Apply(target.GetPrim())
+    bolt = UsdPhysics.FixedJoint.Define(stage, "/target/target_bolt")
+    bolt.CreateBody1Rel().SetTargets([target.GetPath()])
+    weld = UsdPhysics.FixedJoint.Define(stage, "/target/weld")
+    weld.CreateBody0Rel().SetTargets([target.GetPath()])
+    weld.CreateBody1Rel().SetTargets(["/arm0/upper"])
+    weld.CreateExcludeFromArticulationAttr(True)
+    stage.GetRootLayer().Save()
+    spec = yaml.safe_load(import_robot(path, tmp_path / "out").spec_path.read_text())
+    assert "target" not in {link["name"] for link in spec["links"]}
+    listed = {item["what"] for item in spec["source_differences"]}
+    assert {"links.target", "joints.target_bolt"} <= listed

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from simkit.importer.formats.usd import mjc, poses, shapes
-from simkit.importer.formats.usd.stage import Articulation, ends
+from simkit.importer.formats.usd.stage import Articulation, ends, stage_names
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
 UNBOUNDED = 1e30
@@ -69,23 +69,6 @@ class Context:
     turns: dict[int, np.ndarray] = field(default_factory=dict)
 
 
-def unique_names(stage, paths: list[str]) -> dict[str, str]:
-    """Prim path -> its name: its `displayName` where authored (the source's own name, which
-    converters keep there when it is no USD identifier, `0` for a prim `tn__0_`), else the
-    prim's; made unique in path order (`NAME_1`, `NAME_2`...)."""
-    out, taken = {}, set()
-    for path in sorted(paths):
-        prim = stage.GetPrimAtPath(path)
-        shown = prim.GetDisplayName() if prim else ""
-        want = shown or path.rsplit("/", 1)[-1] or "root"
-        name, n = want, 1
-        while name in taken:
-            name, n = f"{want}_{n}", n + 1
-        taken.add(name)
-        out[path] = name
-    return out
-
-
 def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
     """The joint frame on body `end` (0 or 1) in that body's frame (m; the body's world
     scale applied to `localPos`, as PhysX applies it)."""
@@ -108,7 +91,7 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
     from pxr import UsdGeom
 
     ctx = Context(art, poses.Units.of(art.stage), UsdGeom.XformCache(), scratch)
-    every = _stage_names(art.stage)
+    every = stage_names(art.stage)
     ctx.names = {body: every["links"][body] for body in art.bodies}
     joint_names = every["joints"]
     robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
@@ -148,22 +131,24 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list]
             _joint(robot, joint, joint_names, (ctx.names[a], ctx.names[b]), origin, ctx)
         else:
             ctx.dropped.append((joint, "joins the robot to the world away from its root"))
+    _list_left_out(art, frames, every, ctx)
     for element in robot.iter():
         element.sourceline = element.sourceline or 0
     return robot, floating, ctx.listed, ctx.dropped
 
 
-def _stage_names(stage) -> dict[str, dict[str, str]]:
-    """{"links": rigid body path -> name, "joints": joint path -> name} over the whole stage
-    (unique_names): a robot's names do not depend on the scene around it being left out,
-    and are those the source check (check/source/usd/), which reads the whole stage, gives."""
-    from pxr import Usd, UsdPhysics
-
-    every = Usd.TraverseInstanceProxies(Usd.PrimAllPrimsPredicate)
-    prims = list(Usd.PrimRange(stage.GetPseudoRoot(), every))
-    bodies = [str(p.GetPath()) for p in prims if p.HasAPI(UsdPhysics.RigidBodyAPI)]
-    joints = [str(p.GetPath()) for p in prims if p.IsA(UsdPhysics.Joint) and p.IsActive()]
-    return {"links": unique_names(stage, bodies), "joints": unique_names(stage, joints)}
+def _list_left_out(art: Articulation, frames: dict, every: dict, ctx: Context) -> None:
+    """List the bodies the tree does not reach (joined to it only by a joint outside the
+    articulation: a MuJoCo mocap body's weld) and the joints dropped, as the source check
+    names them: it reads the whole stage and fails on what the kit lacks unlisted."""
+    for body in art.bodies:
+        if body not in frames:
+            why = "joined to the robot only by a joint outside the articulation: not imported"
+            ctx.listed.append((f"links.{every['links'][body]}", why))
+    for joint, why in ctx.dropped:
+        name = every["joints"].get(str(joint.GetPath()))
+        if name:
+            ctx.listed.append((f"joints.{name}", f"not imported: {why}"))
 
 
 def _walk(art: Articulation, root: str, ctx: Context):
