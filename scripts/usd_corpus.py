@@ -512,7 +512,9 @@ def table(rows: list[dict], title: str, command: str) -> str:
     import (a scene of several robots, no articulation) is the original format's own import's
     answer too, and a file the converter does not convert has no USD: both are counted apart
     from the robots that do not come back equal."""
-    good = sum(r["ok"] for r in rows)
+    building = any(r["step"] == "build" for r in rows)
+    unbuilt = [r for r in rows if building and r["ok"] and r["step"] == "compare"]
+    good = sum(r["ok"] for r in rows) - len(unbuilt)
     converted = [r for r in rows if r["step"] != "convert"]
     refused = [r for r in converted if r["step"] == "import" and _refusal(r["why"])]
     robots = len(converted) - len(refused)
@@ -522,8 +524,10 @@ def table(rows: list[dict], title: str, command: str) -> str:
         return f"{100.0 * n / robots:.1f} %" if robots else "-"
 
     said = f"of the other {robots}, {equal} give a robot equal to the original ({share(equal)})"
-    if any(r["step"] == "build" for r in rows):
+    if building:
         said += f" and {good} of those a checked kit (the build; {share(good)})"
+    if unbuilt:
+        said += f"; {len(unbuilt)} equal ones not built (the table merges an earlier comparison)"
     lines = [
         f"## {title}",
         "",
@@ -537,7 +541,8 @@ def table(rows: list[dict], title: str, command: str) -> str:
         "|---|---|---|---|",
     ]
     for r in rows:
-        said = "ok" if r["ok"] else "refused" if r in refused else "FAIL"
+        said = "equal, not built" if r in unbuilt else "ok" if r["ok"] else "FAIL"
+        said = "refused" if r in refused else said
         lines.append(f"| {r['file']} | {said} | {r['step']} | {r['why']} |")
     return "\n".join(lines) + "\n"
 
