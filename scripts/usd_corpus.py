@@ -16,12 +16,15 @@ compiled by MuJoCo (MJCF), independently of both converter and importer:
   name (names made USD identifiers, as the converters make them; renames from the spec's
   `source_differences`); a value the import estimated (the spec's `estimated`: a zero
   inertia, a missing limit) is the import's, as for a URDF import, and not compared;
-- each original movable joint: its type (revolute, continuous, prismatic) and limits;
+- each original movable joint: its type (revolute, continuous, prismatic) and limits (a
+  limit of 1e15 or more is none, `NO_LIMIT`: a revolute joint with it is continuous);
 - at 20 seeded configurations (hinge and slide joints in their limits, balls and free joints
   at rest), every massive body's centre of mass (1e-6 m) and inertia tensor in the root
   body's frame: quantities that do not depend on where a format puts its link frames.
 
-With `--build` each spec is also built (`simkit build`, its checks). A row: the robot file,
+With `--reuse` a USD an earlier run converted is not converted again (it is imported again,
+by this code). With `--build` each spec is also built (`simkit build`, its checks; the log in
+OUT/ROBOT/build.log, a failing build's row names its failing checks). A row: the robot file,
 the step reached (convert, import, compare, build), the result and the first difference.
 The table goes into docs/import-corpus.md under its title. No robot is named here.
 """
@@ -33,6 +36,7 @@ import fnmatch
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -46,6 +50,12 @@ sys.path.insert(0, str(REPO / "src"))
 VENV = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "simkit-ci/venv-usdconv"
 SEEDS = 20
 TOL = 1e-6
+#: |limit| (rad or m) from which an original's joint limit is no limit: SDFormat's default
+#: limit is +-1e16 and URDFs made from SDF (a multirotor's rotors) carry it. At the spec's
+#: fastest joint (200 rad/s) 1e15 rad takes 160,000 years: no motion ever reaches it, so
+#: such a revolute joint moves as a continuous one and is compared as one (simkit's own URDF
+#: and SDF imports read it so too). A limit of a few turns (a cable's) stays a limit.
+NO_LIMIT = 1e15
 
 
 def robots(root: Path, mjcf: bool, only: list[str], exclude: list[str]) -> list[Path]:
@@ -113,19 +123,21 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
     conv, out = work / slug / "usd", work / slug / "spec"
     name = f"r_{slug[-40:]}".strip("_")
     env = dict(os.environ, PYTHONPATH=str(REPO / "src"))
-    if not (args.reuse and (out / f"{name}.yaml").is_file()):
+    usdas = sorted(conv.glob("*.usda")) if args.reuse and conv.is_dir() else []
+    if not usdas:
         tool = "mujoco_usd_converter" if args.mjcf else "urdf_usd_converter"
         code, text = _run([str(venv_dir(args) / "bin" / tool), str(path), str(conv)], args.timeout)
         usdas = sorted(conv.glob("*.usda")) if conv.is_dir() else []
         if code or not usdas:
+            shutil.rmtree(conv, ignore_errors=True)  # a failed conversion's part: not reused
             row["why"] = _last(text) or "no USD written"
             return row
-        row["step"] = "import"
-        cmd = [sys.executable, "-m", "simkit.cli", "import", str(usdas[0]), "--out", str(out)]
-        code, text = _run([*cmd, "--name", name, "-q"], args.timeout, env)
-        if code:
-            row["why"] = _last(text)
-            return row
+    row["step"] = "import"  # always with this code: a reused USD is imported again
+    cmd = [sys.executable, "-m", "simkit.cli", "import", str(usdas[0]), "--out", str(out)]
+    code, text = _run([*cmd, "--name", name, "-q"], args.timeout, env)
+    if code:
+        row["why"] = _last(text)
+        return row
     row["step"] = "compare"
     spec = yaml.safe_load((out / f"{name}.yaml").read_text())
     try:
@@ -139,8 +151,9 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
         row["step"] = "build"
         cmd = [sys.executable, "-m", "simkit.cli", "build", str(out / f"{name}.yaml")]
         code, text = _run([*cmd, "--out", str(work / slug / "kits")], args.timeout, env)
+        (work / slug / "build.log").write_text(text + "\n")
         if code:
-            row["why"] = _last(text)
+            row["why"] = _failed(text)
             return row
     row["ok"] = True
     return row
@@ -149,6 +162,15 @@ def _steps(path: Path, rel: str, work: Path, row: dict, args) -> dict:
 def venv_dir(args) -> Path:
     """The converters' venv."""
     return Path(args.venv)
+
+
+def _failed(text: str) -> str:
+    """A failed build's checks: the failing checks' names, then the first one's line."""
+    fails = [line.strip() for line in text.splitlines() if line.strip().startswith("FAIL ")]
+    if not fails:
+        return _last(text)
+    names = ", ".join(sorted({line.split()[1].rstrip(":") for line in fails}))
+    return f"{names}: {fails[0]}"[:300].replace("|", "/")
 
 
 def _last(text: str) -> str:
@@ -338,6 +360,15 @@ def _compare_bodies(
     return out
 
 
+def _unlimited(kind: str, limits: tuple | None) -> tuple[str, tuple | None]:
+    """(type, limits) of an original joint as it moves: a limit at or beyond NO_LIMIT is
+    none, and a revolute joint with such a limit is continuous. (A URDF revolute without
+    lower/upper is not: its limits default to 0, which the import estimates.)"""
+    if limits is None or max(map(abs, limits)) < NO_LIMIT:
+        return kind, limits
+    return ("continuous" if kind == "revolute" else kind), None
+
+
 def compare_urdf(path: Path, spec: dict) -> list[str]:
     """The spec against the original URDF (yourdfpy)."""
     import tempfile
@@ -360,7 +391,7 @@ def compare_urdf(path: Path, spec: dict) -> list[str]:
             limits = None
             if j.type != "continuous" and lim is not None and lim.lower is not None:
                 limits = (float(lim.lower), float(lim.upper))
-            joints[j.name] = (j.type, limits)
+            joints[j.name] = _unlimited(j.type, limits)
     children = {j.child for j in robot.joints}
     root = next(link.name for link in robot.links if link.name not in children)
     kit_root = kit.name("links", root)
@@ -435,7 +466,7 @@ def compare_mjcf(path: Path, spec: dict) -> list[str]:
             limits = tuple(float(v) for v in model.jnt_range[j]) if model.jnt_limited[j] else None
             if kind == "revolute" and limits is None:
                 kind = "continuous"
-            joints[model.joint(j).name or f"jnt{j}"] = (kind, limits)
+            joints[model.joint(j).name or f"jnt{j}"] = _unlimited(kind, limits)
     kit_root = kit.name("links", name[top])
 
     def poses_fn(rng):
@@ -481,11 +512,22 @@ def table(rows: list[dict], title: str, command: str) -> str:
     import (a scene of several robots, no articulation) is the original format's own import's
     answer too, and a file the converter does not convert has no USD: both are counted apart
     from the robots that do not come back equal."""
-    good = sum(r["ok"] for r in rows)
+    building = any(r["step"] == "build" for r in rows)
+    unbuilt = [r for r in rows if building and r["ok"] and r["step"] == "compare"]
+    good = sum(r["ok"] for r in rows) - len(unbuilt)
     converted = [r for r in rows if r["step"] != "convert"]
     refused = [r for r in converted if r["step"] == "import" and _refusal(r["why"])]
     robots = len(converted) - len(refused)
-    share = f"{100.0 * good / robots:.1f} %" if robots else "-"
+    equal = sum(r["ok"] or r["step"] == "build" for r in rows)  # compared equal, then built
+
+    def share(n: int) -> str:
+        return f"{100.0 * n / robots:.1f} %" if robots else "-"
+
+    said = f"of the other {robots}, {equal} give a robot equal to the original ({share(equal)})"
+    if building:
+        said += f" and {good} of those a checked kit (the build; {share(good)})"
+    if unbuilt:
+        said += f"; {len(unbuilt)} equal ones not built (the table merges an earlier comparison)"
     lines = [
         f"## {title}",
         "",
@@ -493,13 +535,14 @@ def table(rows: list[dict], title: str, command: str) -> str:
         "",
         f"{len(rows)} files: {len(rows) - len(converted)} not converted by the converter, "
         f"{len(refused)} refused in one line by the import (several robots, no articulation); "
-        f"of the other {robots}, {good} give a robot equal to the original ({share}).",
+        f"{said}.",
         "",
         "| file | result | step | first difference or error |",
         "|---|---|---|---|",
     ]
     for r in rows:
-        said = "ok" if r["ok"] else "refused" if r in refused else "FAIL"
+        said = "equal, not built" if r in unbuilt else "ok" if r["ok"] else "FAIL"
+        said = "refused" if r in refused else said
         lines.append(f"| {r['file']} | {said} | {r['step']} | {r['why']} |")
     return "\n".join(lines) + "\n"
 
@@ -530,7 +573,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("/tmp/simkit-usd-corpus"))
     parser.add_argument("--build", action="store_true", help="also build each spec")
     parser.add_argument(
-        "--reuse", action="store_true", help="compare again the specs an earlier run imported"
+        "--reuse", action="store_true", help="reuse the USD an earlier run converted"
     )
     parser.add_argument("--limit", type=int, default=0)
     parser.add_argument("--timeout", type=float, default=600.0)

@@ -358,6 +358,8 @@ def files_block(robot: Robot, kit_files: Iterable[str]) -> dict[str, str]:
     each one without knowing the layout (issue 38)."""
     have = set(kit_files)
     files = dict(document_files(robot))
+    if (gpu_scene(robot) or {}).get("file", "") is None:  # no GPU scene written: not listed
+        files.pop("mjcf_mjx")
     for key, candidates in _more_formats(robot.name):
         found = next((path for path in candidates if path in have), None)
         if found is not None:

@@ -34,6 +34,9 @@ class Articulation:
     #: further root bodies, each bolted to the world like the first (several articulations
     #: of one robot: urdf-usd-converter writes one per child of a massless root link)
     more_roots: list[str] = field(default_factory=list)
+    #: (kind, prim paths) left out as the scene's, not the robot's: "links" (rigid bodies not
+    #: joined to it), "joints" (joints touching none of its bodies)
+    apart: dict[str, list[str]] = field(default_factory=dict)
 
 
 def open_stage(path: Path, root_layer, variant: str | None):
@@ -102,6 +105,8 @@ def articulation(path: Path, stage) -> Articulation:
     touching = [j for j in linking if {t for t in _ends(j) if t} & found]
     out = Articulation(stage, stage.GetPrimAtPath(root), sorted(found), touching, notes=notes)
     out.more_roots = held[1:]
+    away = [str(j.GetPath()) for j in joints if not {t for t in _ends(j) if t} & found]
+    out.apart = {"links": sorted(apart), "joints": sorted(away)}
     return out
 
 
@@ -189,3 +194,33 @@ def _root_body(root_prim, graph: dict, bodies: set[str], joints: list) -> str:
     children = {_ends(j)[1] for j in joints if _ends(j)[0] in bodies}
     free = [b for b in under if b not in children and graph.get(b)]
     return (free or under)[0]
+
+
+def unique_names(stage, paths: list[str]) -> dict[str, str]:
+    """Prim path -> its name: its `displayName` where authored (the source's own name, which
+    converters keep there when it is no USD identifier, `0` for a prim `tn__0_`), else the
+    prim's; made unique in path order (`NAME_1`, `NAME_2`...)."""
+    out, taken = {}, set()
+    for path in sorted(paths):
+        prim = stage.GetPrimAtPath(path)
+        shown = prim.GetDisplayName() if prim else ""
+        want = shown or path.rsplit("/", 1)[-1] or "root"
+        name, n = want, 1
+        while name in taken:
+            name, n = f"{want}_{n}", n + 1
+        taken.add(name)
+        out[path] = name
+    return out
+
+
+def stage_names(stage) -> dict[str, dict[str, str]]:
+    """{"links": rigid body path -> name, "joints": joint path -> name} over the whole stage
+    (unique_names): a robot's names do not depend on the scene around it being left out,
+    and are those the source check (check/source/usd/), which reads the whole stage, gives."""
+    from pxr import Usd, UsdPhysics
+
+    every = Usd.TraverseInstanceProxies(Usd.PrimAllPrimsPredicate)
+    prims = list(Usd.PrimRange(stage.GetPseudoRoot(), every))
+    bodies = [str(p.GetPath()) for p in prims if p.HasAPI(UsdPhysics.RigidBodyAPI)]
+    joints = [str(p.GetPath()) for p in prims if p.IsA(UsdPhysics.Joint) and p.IsActive()]
+    return {"links": unique_names(stage, bodies), "joints": unique_names(stage, joints)}

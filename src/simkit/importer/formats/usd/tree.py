@@ -25,7 +25,8 @@ repair `second_parents` leaves it out (listed as dropped).
 
 Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
 frame; where the mass is not authored, the collision shapes' solid at the MassAPI `density`
-(else 1000 kg/m^3, UsdPhysics' default), its CoM and inertia where those are not authored.
+(else 1000 kg/m^3, UsdPhysics' default), its CoM and inertia where those are not authored;
+all scaled to MjcPhysics' `setTotalMass` where the stage sets it (mjc.py).
 """
 
 from __future__ import annotations
@@ -36,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.usd import dynamics, limits, poses, shapes
-from simkit.importer.formats.usd.stage import Articulation, ends
+from simkit.importer.formats.usd import dynamics, limits, mjc, poses, shapes
+from simkit.importer.formats.usd.stage import Articulation, ends, stage_names
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
 UNBOUNDED = 1e30
@@ -76,23 +77,6 @@ class Context:
     others: list | None = None
 
 
-def unique_names(stage, paths: list[str]) -> dict[str, str]:
-    """Prim path -> its name: its `displayName` where authored (the source's own name, which
-    converters keep there when it is no USD identifier, `0` for a prim `tn__0_`), else the
-    prim's; made unique in path order (`NAME_1`, `NAME_2`...)."""
-    out, taken = {}, set()
-    for path in sorted(paths):
-        prim = stage.GetPrimAtPath(path)
-        shown = prim.GetDisplayName() if prim else ""
-        want = shown or path.rsplit("/", 1)[-1] or "root"
-        name, n = want, 1
-        while name in taken:
-            name, n = f"{want}_{n}", n + 1
-        taken.add(name)
-        out[path] = name
-    return out
-
-
 def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
     """The joint frame on body `end` (0 or 1) in that body's frame (m; the body's world
     scale applied to `localPos`, as PhysX applies it)."""
@@ -117,8 +101,9 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list,
     from pxr import UsdGeom
 
     ctx = Context(art, poses.Units.of(art.stage), UsdGeom.XformCache(), scratch)
-    ctx.names = unique_names(art.stage, art.bodies)
-    joint_names = unique_names(art.stage, [str(j.GetPath()) for j in art.joints])
+    every = stage_names(art.stage)
+    ctx.names = {body: every["links"][body] for body in art.bodies}
+    joint_names = every["joints"]
     robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
     robot.sourceline = 0
     root = str(art.root_prim.GetPath())
@@ -134,6 +119,11 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list,
     for body in art.bodies:
         if body in frames:
             _link(robot, body, frames[body], ctx)
+    mjc.scale_to_total(robot, art, ctx.units.kilograms, ctx.listed)
+    for kind in ("links", "joints"):
+        for path in art.apart.get(kind, []):
+            why = "the scene's, not joined to the robot: not imported"
+            ctx.listed.append((f"{kind}.{every[kind][path]}", why))
     for name in ctx.added:
         etree.SubElement(robot, "link", name=name)
     for joint, parent, child, flip, origin in order:
@@ -151,9 +141,24 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list,
             _joint(robot, joint, joint_names, (ctx.names[a], ctx.names[b]), origin, ctx)
         else:
             ctx.dropped.append((joint, "joins the robot to the world away from its root"))
+    _list_left_out(art, frames, every, ctx)
     for element in robot.iter():
         element.sourceline = element.sourceline or 0
     return robot, floating, ctx.listed, ctx.dropped, ctx
+
+
+def _list_left_out(art: Articulation, frames: dict, every: dict, ctx: Context) -> None:
+    """List the bodies the tree does not reach (joined to it only by a joint outside the
+    articulation: a MuJoCo mocap body's weld) and the joints dropped, as the source check
+    names them: it reads the whole stage and fails on what the kit lacks unlisted."""
+    for body in art.bodies:
+        if body not in frames:
+            why = "joined to the robot only by a joint outside the articulation: not imported"
+            ctx.listed.append((f"links.{every['links'][body]}", why))
+    for joint, why in ctx.dropped:
+        name = every["joints"].get(str(joint.GetPath()))
+        if name:
+            ctx.listed.append((f"joints.{name}", f"not imported: {why}"))
 
 
 def _walk(art: Articulation, root: str, ctx: Context):
