@@ -9,6 +9,8 @@ Frames: the kit's link frame of a body is its body frame moved (not turned) to t
 frame on it (importer/formats/usd/tree.py); `source_robot` finds that frame from the parser's
 joints with the same breadth-first walk. Kept apart from the comparison (the package's
 `__init__.py`) because it is the one place that speaks pxr, imported lazily per function.
+Bodies and joints are named as the import names them (`unique_names`): a naming convention
+the kit must match, not part of the proof.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from simkit.check.source.usd import dynamics
+from simkit.importer.formats.usd.stage import unique_names
 
 
 @dataclass
@@ -127,21 +130,6 @@ def _quat(w: float, x: float, y: float, z: float) -> np.ndarray:
     ])  # fmt: skip
 
 
-def _unique(stage, paths) -> dict[str, str]:
-    """Prim path -> its name (its displayName where authored), made unique in path order, as
-    the import names them."""
-    out, taken = {}, set()
-    for path in sorted(paths):
-        prim = stage.GetPrimAtPath(path)
-        want = (prim.GetDisplayName() if prim else "") or path.rsplit("/", 1)[-1] or "root"
-        name, n = want, 1
-        while name in taken:
-            name, n = f"{want}_{n}", n + 1
-        taken.add(name)
-        out[path] = name
-    return out
-
-
 def source_robot(path: Path, variant: str | None) -> Robot:
     """The composed stage's robot as usd-core's UsdPhysics parser describes it."""
     from pxr import Usd, UsdGeom, UsdPhysics
@@ -164,13 +152,13 @@ def source_robot(path: Path, variant: str | None) -> Robot:
         UsdPhysics.ObjectType.SphericalJoint: "spherical",
     }
     body_paths = [str(p) for p in parsed.get(UsdPhysics.ObjectType.RigidBody, ([], []))[0]]
-    names = _unique(stage, body_paths)
+    names = unique_names(stage, body_paths)
     joints, joint_paths = [], []
     for kind, label in kinds.items():
         for at, desc in zip(*parsed.get(kind, ([], [])), strict=True):
             joints.append((str(at), label, desc))
             joint_paths.append(str(at))
-    joint_names = _unique(stage, joint_paths)
+    joint_names = unique_names(stage, joint_paths)
     every = Usd.PrimRange(stage.GetPseudoRoot(), Usd.TraverseInstanceProxies())
     authored = {str(p.GetPath()): i for i, p in enumerate(every)}
     robot = Robot()
