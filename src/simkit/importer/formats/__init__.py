@@ -29,6 +29,7 @@ from pathlib import Path
 from simkit.importer import read
 from simkit.importer.diagnostics import Report
 from simkit.importer.formats import mjcf, sdf, urdf, usd, xacro
+from simkit.importer.formats.urdf.model import robot_of
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -112,6 +113,7 @@ def load(
     source = read.shell(path, package_dirs, report, options)
     fmt = (picked or pick(path)).format
     done = fmt.read(source, options)
+    done.robot = robot_of(done)  # the source model the translation reads
     for doc in (done, done.kept):
         doc.format, doc.noun = fmt.name, fmt.noun
     done.original = hashlib.sha256(path.read_bytes()).hexdigest()

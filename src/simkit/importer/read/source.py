@@ -46,6 +46,9 @@ class Source:
     #: joints taken out of the tree because their child already hangs from an earlier one
     #: (a closed loop, importer/translate/loops.py): each becomes a spec `loops` weld
     closures: list = field(default_factory=list)
+    #: the source model the translation reads (read/model.py `Robot`), numbers as numbers:
+    #: set once the format's reader is done (formats.load)
+    robot: object = None
 
     @property
     def a_noun(self) -> str:
