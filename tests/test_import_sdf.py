@@ -17,6 +17,7 @@ from lxml import etree
 from simkit.errors import SpecError
 from simkit.importer import formats
 from simkit.importer.diagnostics import Policy, Report
+from simkit.importer.formats.urdf.document import document
 from simkit.importer.translate import ball_joints
 
 pytest.importorskip("pydrake")
@@ -31,11 +32,11 @@ def _read(path: Path):
 
 
 def _findings(path: Path, tmp_path: Path, tamper=None) -> list:
-    """The proof's findings: Drake's reading of the SDF against the reader's tree (as URDF,
-    a ball joint as the three revolute ones the translation makes of it)."""
+    """The proof's findings: Drake's reading of the SDF against the reader's source model
+    (written as URDF, a ball joint as the three revolute ones the translation makes of it)."""
     read = _read(path)
-    ball_joints.expand(read)
-    tree = read.root
+    ball_joints.expand(read)  # on the source model, which is what the translation reads
+    tree = document(read.robot)
     if tamper:
         tamper(tree)
     urdf = tmp_path / "tree.urdf"

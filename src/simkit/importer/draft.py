@@ -71,7 +71,6 @@ class Draft:
     #: the format's keep (fixups/overlap.py: pairs excluded at the source's home)
     listed: list = field(default_factory=list)
     #: the source's first element of each (tag, name), built on first use by `where`
-    _named: dict | None = field(default=None, repr=False)
 
     def robot(self) -> Robot:
         """The draft as simkit's model (model/resolve.py): schema-checked, not yet
@@ -86,34 +85,32 @@ class Draft:
         return self.resolved
 
     def where(self, tag: str, name: str, child: str | None = None):
-        """The source element a report record about spec item `name` points at: the first
-        `<tag name=...>` of the source (its `child`, when it has one), else the document's
-        root. The fix-ups locate their records so, without querying the source."""
-        if self._named is None:
-            self._named = {}
-            for element in self.source.root:
-                key = (element.tag, element.get("name"))
-                self._named.setdefault(key, element)
-        element = self._named.get((tag, name))
-        if element is None:
-            return self.source.root
-        found = element.find(child) if child else None
-        return element if found is None else found
+        """Where in the source a report record about spec item `name` points: the first
+        link or joint (`tag`) of that name in the source model (its `child` element, a
+        joint's `limit`, when it has one), else the document's root. The fix-ups locate
+        their records so, without querying the source."""
+        robot = self.source.robot
+        node = robot.joint(name) if tag == "joint" else robot.link(name)
+        if node is None:
+            return robot.at
+        found = getattr(node, child, None) if child else None
+        return node.at if found is None else found.at
 
     def note(self, message: str, where=None) -> None:
         """A report record (`estimated`, never refused by --strict) of a value the import
         chose, at `where` (an element `where()` gave), else the document's root."""
-        self.report.assumed(self.source, self.source.root if where is None else where, message)
+        self.report.assumed(self.source, self.source.robot.at if where is None else where, message)
 
     def note_named(self, tag: str, name: str, message: str) -> None:
         """A report record (`changed`) at the first `<tag name=...>` anywhere in the source
         (a renamed link or joint, by its source name)."""
-        element = next((e for e in self.source.root.iter(tag) if e.get("name") == name), None)
-        self.report.changed(self.source, element, message)
+        robot = self.source.robot
+        node = robot.joint(name) if tag == "joint" else robot.link(name)
+        self.report.changed(self.source, None if node is None else node.at, message)
 
     def note_change(self, message: str) -> None:
         """A report record (`changed`) of the robot kept in another form, at the root."""
-        self.report.changed(self.source, self.source.root, message)
+        self.report.changed(self.source, self.source.robot.at, message)
 
     def changed(self) -> None:
         """Forget the resolved model after a change of `spec`."""

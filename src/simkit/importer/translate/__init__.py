@@ -3,9 +3,9 @@
 `to_spec` decides the base from the robot's structure (base.py) unless the user or the
 format set it, turns Y-up COLLADA meshes (up_axis.py) and converts links, joints and frames
 (convert.py with links.py, joints.py, geometry.py, meshes.py, masses.py, solids.py,
-ball_joints.py). It reads the one `Source` every format's reader gives (importer/formats)
-and knows no format; the spec edits that follow (legal names, the format's own edits, the
-STEP budget) are fix-ups (importer.steps).
+ball_joints.py). It reads the one source model every format's reader gives
+(`Source.robot`, read/model.py) and knows no format; the spec edits that follow (legal
+names, the format's own edits, the STEP budget) are fix-ups (importer.steps).
 """
 
 from __future__ import annotations
@@ -24,17 +24,17 @@ def to_spec(draft: Draft) -> None:
     if draft.options.floating is None and source.base is not None:  # the format says
         floating, why = source.base
         draft.options = replace(draft.options, floating=floating)
-        report.assumed(source, source.root, why)
+        report.assumed(source, source.robot.at, why)
     options = draft.options
     draft.legged, why = base.decide(source)
     floating = options.floating
     if floating is None:
         floating = draft.legged
-        report.assumed(source, source.root, why)
+        report.assumed(source, source.robot.at, why)
     mesh_writer = meshes.MeshWriter(draft.stage)
     mesh_writer.turn_y_up, why = turn_y_up(source)  # Y_UP COLLADA meshes drawn so: turned
     if why:
-        report.changed(source, source.root, why)
+        report.changed(source, source.robot.at, why)
     draft.spec = convert.convert(
         source, options.name, mesh_writer, report, floating, options.hull_collision,
         options.density,

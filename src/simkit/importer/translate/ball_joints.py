@@ -21,26 +21,44 @@ PyBullet ignores a spherical joint's `<axis>`; so does the import.
 
 from __future__ import annotations
 
-from copy import deepcopy
+from dataclasses import replace
 
+from simkit.importer.read.model import At, Joint, Limit, Link, Pose
 from simkit.importer.read.source import Source
-from simkit.importer.translate.geometry import floats
 
 KIND = "spherical"
 #: (name suffix, axis, PyBullet `<limit>` attribute holding that axis's half range)
-AXES = (("_x", "1 0 0", "lower"), ("_y", "0 1 0", "upper"), ("", "0 0 1", "twist"))
+AXES = (
+    ("_x", (1.0, 0.0, 0.0), "lower"),
+    ("_y", (0.0, 1.0, 0.0), "upper"),
+    ("", (0.0, 0.0, 1.0), "twist"),
+)
 
 
 def expand(source: Source) -> None:
-    """Replace every `<joint type="spherical">` of the parsed URDF by three joints and two
-    massless links, in place; one report line each (`--strict` refuses instead)."""
-    balls = [j for j in source.root.findall("joint") if j.get("type") == KIND]
+    """Replace every spherical joint of the source model by three joints and two massless
+    links (`source.robot` replaced); one report line each (`--strict` refuses instead)."""
+    robot = source.robot
+    balls = [j for j in robot.joints if j.type == KIND]
     if not balls:
         return
-    links = {link.get("name") for link in source.root.findall("link")}
-    joints = {joint.get("name") for joint in source.root.findall("joint")}
-    for joint in balls:
-        _expand_one(source, joint, links, joints)
+    links = {link.name for link in robot.links}
+    joints = {joint.name for joint in robot.joints}
+    new_joints: list[Joint] = []
+    added: dict[str, list[Link]] = {}  # child link name -> the chain's links before it
+    for joint in robot.joints:
+        if joint.type != KIND:
+            new_joints.append(joint)
+            continue
+        chain, bodies = _expand_one(source, joint, links, joints)
+        new_joints.extend(chain)
+        added.setdefault(joint.child, []).extend(bodies)
+    new_links: list[Link] = []
+    for link in robot.links:  # before the child link: the chain keeps its place among siblings
+        if link.name in added:
+            new_links.extend(added.pop(link.name))
+        new_links.append(link)
+    source.robot = replace(robot, links=tuple(new_links), joints=tuple(new_joints))
 
 
 def _free(name: str, taken: set) -> str:
@@ -52,25 +70,24 @@ def _free(name: str, taken: set) -> str:
     return out
 
 
-def _ranges(source: Source, joint) -> tuple[float, float, float] | None:
+def _ranges(joint: Joint) -> tuple[float, float, float] | None:
     """PyBullet's (swing x, swing y, twist) half ranges in rad, or None: no limit."""
-    limit = joint.find("limit")
+    limit = joint.limit
     if limit is None:
         return None
-    keys = ("lower", "upper", "twist", "effort")
-    values = [floats(source, limit, key, 1, "0") for key in keys]
+    values = [v or 0.0 for v in (limit.lower, limit.upper, limit.twist, limit.effort)]
     return tuple(values[:3]) if all(v > 0 for v in values) else None  # type: ignore[return-value]
 
 
-def _expand_one(source: Source, joint, links: set, joints: set) -> None:
-    name = joint.get("name") or ""
-    parent, child = joint.find("parent"), joint.find("child")
-    if parent is None or child is None or not parent.get("link") or not child.get("link"):
-        raise source.fail(joint, "a joint needs <parent link=...> and <child link=...>")
-    for end in (parent, child):
-        if end.get("link") not in links:
-            raise source.fail(joint, f"unknown {end.tag} link '{end.get('link')}'")
-    ranges = _ranges(source, joint)
+def _expand_one(source: Source, joint: Joint, links: set, joints: set):
+    """The three joints (the last keeps the ball's name and line) and the two links."""
+    name = joint.name or ""
+    if not joint.parent or not joint.child:
+        raise source.fail(joint.at, "a joint needs <parent link=...> and <child link=...>")
+    for end, link in (("parent", joint.parent), ("child", joint.child)):
+        if link not in links:
+            raise source.fail(joint.at, f"unknown {end} link '{link}'")
+    ranges = _ranges(joint)
     names = [_free(f"{name}{suffix}", joints) if suffix else name for suffix, _, _ in AXES]
     bodies = [_free(f"{n}_link", links) for n in names[:2]]
     if ranges is None:
@@ -80,70 +97,42 @@ def _expand_one(source: Source, joint, links: set, joints: set) -> None:
         how = "revolute, limits +-{:g}, +-{:g}, +-{:g} rad (PyBullet's swing x = lower, swing "
         how = (how + "y = upper, twist = twist)").format(*ranges)
     source.lenient(
-        joint,
+        joint.at,
         f"spherical joint {name}: three revolute joints {', '.join(names)} about the joint "
         f"frame's x, y, z axes through massless links {', '.join(bodies)}; {how}",
     )
-    ends = [parent.get("link"), *bodies, child.get("link")]
-    built = [_joint(joint, n, ends[i], ends[i + 1], AXES[i], ranges) for i, n in enumerate(names)]
-    for element in built[:2]:
-        joint.addprevious(element)
-    _retype(joint, built[2])
-    anchor = next(x for x in source.root.findall("link") if x.get("name") == ends[-1])
-    for body in bodies:  # before the child link: the chain keeps its place among siblings
-        link = anchor.makeelement("link", {"name": body})
-        _keep_line(link, joint)
-        anchor.addprevious(link)
+    ends = [joint.parent, *bodies, joint.child]
+    chain = [_joint(joint, n, ends[i], ends[i + 1], AXES[i], ranges) for i, n in enumerate(names)]
+    line = joint.at.sourceline
+    return chain, [Link(body, At("link", body, line)) for body in bodies]
 
 
-def _joint(ball, name: str, parent: str, child: str, axis: tuple, ranges) -> object:
-    """One joint of the chain: the first takes the ball's `<origin>`, all its `<limit>`
-    effort and velocity and its `<dynamics>`."""
+def _joint(ball: Joint, name: str, parent: str, child: str, axis: tuple, ranges) -> Joint:
+    """One joint of the chain: the first takes the ball's origin, all its `<limit>` effort
+    and velocity and its `<dynamics>`; the last is the ball's own element (its line, its
+    name and any other child element stay, so the usual rules report them)."""
     _, xyz, key = axis
     kind = "continuous" if ranges is None else "revolute"
-    out = ball.makeelement("joint", {"name": name, "type": kind})
-    _keep_line(out, ball)
-    for tag, attrs in (("parent", {"link": parent}), ("child", {"link": child})):
-        out.append(out.makeelement(tag, attrs))
-    origin = ball.find("origin")
-    if origin is not None and parent == ball.find("parent").get("link"):
-        out.append(_copy(origin))
-    out.append(out.makeelement("axis", {"xyz": xyz}))
-    limit = ball.find("limit")
-    if limit is not None:
-        attrs = {k: limit.get(k) for k in ("effort", "velocity") if limit.get(k) is not None}
-        if ranges is not None:
-            half = f"{ranges[[a[2] for a in AXES].index(key)]!r}"
-            attrs.update(lower=f"-{half}", upper=half)
-        element = out.makeelement("limit", attrs)
-        _keep_line(element, limit)
-        out.append(element)
-    dynamics = ball.find("dynamics")
-    if dynamics is not None:
-        out.append(_copy(dynamics))
-    return out
-
-
-def _keep_line(element, origin) -> None:
-    """`element` takes `origin`'s source line, where it has one (an MJCF's tree, built from
-    the compiled model, has none)."""
-    if origin.sourceline is not None:
-        element.sourceline = origin.sourceline
-
-
-def _copy(element):
-    """A copy of an element that keeps its source line (for report lines)."""
-    out = deepcopy(element)
-    _keep_line(out, element)
-    return out
-
-
-def _retype(ball, last) -> None:
-    """The URDF's own joint element becomes the chain's last joint (its line, its name and
-    any other child element stay, so the usual rules report them)."""
-    for tag in ("parent", "origin", "axis", "limit"):
-        for element in ball.findall(tag):
-            ball.remove(element)
-    ball.set("type", last.get("type"))
-    for element in reversed([e for e in last if e.tag in ("parent", "axis", "limit")]):
-        ball.insert(0, element)
+    last = name == ball.name and child == ball.child
+    at = ball.at if last else At("joint", name, ball.at.sourceline)
+    limit = None
+    if ball.limit is not None:
+        half = None if ranges is None else ranges[[a[2] for a in AXES].index(key)]
+        lower, upper = (None, None) if half is None else (-half, half)
+        if kind == "continuous":
+            lower = upper = None
+        limit = Limit(ball.limit.at, lower, upper, ball.limit.effort, ball.limit.velocity)
+    return Joint(
+        name,
+        kind,
+        at,
+        parent,
+        child,
+        ball.origin if parent == ball.parent else Pose(),
+        xyz,
+        ball.axis_at if last else None,
+        limit,
+        ball.dynamics,
+        ball.mimic if last else None,
+        ball.unknown if last else (),
+    )

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from simkit.importer.read.model import Pose
 from simkit.importer.read.source import Source
 from simkit.importer.translate.convert import tree
-from simkit.importer.translate.geometry import origin
 from simkit.model.kinematics import rpy_matrix
 
 #: share of the robot's height span (z at the zero pose) a leg reaches below the root
@@ -36,25 +36,24 @@ MOVABLE = ("revolute", "continuous", "prismatic", "planar", "floating", "spheric
 RANGED = ("revolute", "prismatic", "spherical")  # a limb with only continuous joints: wheels
 
 
-def _transform(source: Source, element) -> np.ndarray:
-    """The 4x4 pose of an element's `<origin>` (m, rad)."""
-    xyz, rpy = origin(source, element)
+def _transform(pose: Pose) -> np.ndarray:
+    """The 4x4 matrix of a source model pose (m, rad)."""
     out = np.eye(4)
-    out[:3, :3] = rpy_matrix(rpy)
-    out[:3, 3] = xyz
+    out[:3, :3] = rpy_matrix(pose.rpy)
+    out[:3, 3] = pose.xyz
     return out
 
 
-def _points(source: Source, links: dict, by_child: dict, root: str) -> dict[str, np.ndarray]:
+def _points(links: dict, by_child: dict, root: str) -> dict[str, np.ndarray]:
     """Each link's origin and CoM (rows, m) in the root frame at the zero pose."""
     poses = {root: np.eye(4)}
     pending = [n for n in links if n != root]
     while pending:
         rest = []
         for name in pending:
-            parent = by_child[name].find("parent").get("link")
+            parent = by_child[name].parent
             if parent in poses:
-                poses[name] = poses[parent] @ _transform(source, by_child[name])
+                poses[name] = poses[parent] @ _transform(by_child[name].origin)
             else:
                 rest.append(name)
         if len(rest) == len(pending):
@@ -63,9 +62,9 @@ def _points(source: Source, links: dict, by_child: dict, root: str) -> dict[str,
     out = {}
     for name, pose in poses.items():
         rows = [pose[:3, 3]]
-        inertial = links[name].find("inertial")
-        if inertial is not None and inertial.find("mass") is not None:
-            rows.append((pose @ _transform(source, inertial))[:3, 3])
+        inertial = links[name].inertial
+        if inertial is not None and inertial.mass_at is not None:
+            rows.append((pose @ _transform(inertial.origin))[:3, 3])
         out[name] = np.array(rows)
     return out
 
@@ -76,7 +75,7 @@ def _limbs(links: dict, by_child: dict, root: str) -> list[tuple[list[str], bool
     whether it is a hand (a link with two or more movable branches below it: fingers)."""
     kids: dict[str, list[str]] = {}
     for child, joint in by_child.items():
-        kids.setdefault(joint.find("parent").get("link"), []).append(child)
+        kids.setdefault(joint.parent, []).append(child)
 
     def below(name: str) -> list[str]:
         out, stack = [], [name]
@@ -87,17 +86,15 @@ def _limbs(links: dict, by_child: dict, root: str) -> list[tuple[list[str], bool
         return out
 
     def hand(limb: list[str]) -> bool:
-        return any(
-            sum(by_child[kid].get("type") in MOVABLE for kid in kids.get(n, [])) >= 2 for n in limb
-        )
+        return any(sum(by_child[kid].type in MOVABLE for kid in kids.get(n, [])) >= 2 for n in limb)
 
     limbs, stack = [], [root]
     while stack:  # the welded frame: the root and what fixed joints hold to it
         node = stack.pop()
         for child in kids.get(node, []):
-            if by_child[child].get("type") in MOVABLE:
+            if by_child[child].type in MOVABLE:
                 limb = below(child)
-                if any(by_child[n].get("type") in RANGED for n in limb):
+                if any(by_child[n].type in RANGED for n in limb):
                     limbs.append((limb, hand(limb)))
             else:
                 stack.append(child)
@@ -112,7 +109,7 @@ def legs(source: Source) -> tuple[list[list[str]], str]:
     """The limbs that are legs (their links), deepest first, and the figures of the report
     line: how many limbs reach how far below the root, against which drop."""
     links, by_child, root = tree(source)
-    points = _points(source, links, by_child, root)
+    points = _points(links, by_child, root)
     every = np.vstack(list(points.values()))
     span = float(every[:, 2].max() - every[:, 2].min())
     drop = max(LEG * span, MIN_DROP)
@@ -145,9 +142,7 @@ def legs(source: Source) -> tuple[list[list[str]], str]:
 def _bolted(source: Source) -> bool:
     """True when the root is `world` and a fixed joint holds the robot to it."""
     _links, by_child, root = tree(source)
-    return root == WORLD and any(
-        j.find("parent").get("link") == root and j.get("type") == "fixed" for j in by_child.values()
-    )
+    return root == WORLD and any(j.parent == root and j.type == "fixed" for j in by_child.values())
 
 
 def decide(source: Source) -> tuple[bool, str]:

@@ -1,4 +1,5 @@
-"""A parsed URDF to a spec dict: the tree, its root, frames, poses and the report."""
+"""The source model (read/model.py) to a spec dict: the tree, its root, frames, poses and
+the report."""
 
 from __future__ import annotations
 
@@ -9,7 +10,6 @@ import numpy as np
 from simkit.importer.diagnostics import Report
 from simkit.importer.read.source import Source
 from simkit.importer.translate.ball_joints import expand as expand_ball_joints
-from simkit.importer.translate.geometry import floats
 from simkit.importer.translate.joints import first_leaders, joint_spec, mimic_limits
 from simkit.importer.translate.links import has_geometry, has_mass, link_spec
 from simkit.importer.translate.meshes import MeshWriter
@@ -18,54 +18,55 @@ from simkit.kitio.oneline import one_line
 from simkit.spec.bounds import MAX_BODIES
 from simkit.spec.urdf_blocks import TAGS as URDF_BLOCK_TAGS
 
-TOP = ("link", "joint", "material")
-
 
 def tree(source: Source) -> tuple[dict, dict, str]:
-    """Links by name, joints by child, and the root link; errors for cycles and orphans."""
+    """Links by name, joints by child, and the root link (source model nodes); errors for
+    cycles and orphans."""
+    robot = source.robot
     links: dict = {}
-    for link in source.root.findall("link"):
-        name = link.get("name")
-        if not name:
-            raise source.fail(link, "a link needs a name")
-        if name in links:
-            raise source.fail(link, f"link '{name}' is defined twice, differently")
-        links[name] = link
+    for link in robot.links:
+        if not link.name:
+            raise source.fail(link.at, "a link needs a name")
+        if link.name in links:
+            raise source.fail(link.at, f"link '{link.name}' is defined twice, differently")
+        links[link.name] = link
     if not links:
-        raise source.fail(source.root, "no <link> in the robot")
+        raise source.fail(robot.at, "no <link> in the robot")
     if len(links) > MAX_BODIES:  # refused before any per-link work (a 10,000-link chain)
         raise source.fail(
-            source.root, f"{len(links)} links: a spec holds at most {MAX_BODIES} (spec/bounds.py)"
+            robot.at, f"{len(links)} links: a spec holds at most {MAX_BODIES} (spec/bounds.py)"
         )
     by_child: dict = {}
     joint_names: set = set()
-    for joint in source.root.findall("joint"):
-        if joint.get("name") in joint_names:
-            raise source.fail(joint, f"joint '{joint.get('name')}' is defined twice, differently")
-        joint_names.add(joint.get("name"))
-        for end in ("parent", "child"):
-            tag = joint.find(end)
-            if tag is not None and tag.get("link") not in links:
-                raise source.fail(joint, f"unknown {end} link '{tag.get('link')}'")
-        child = joint.find("child")
-        if child is None:
-            raise source.fail(joint, "a joint needs <child link=...>")
-        if child.get("link") in by_child:
-            raise source.fail(joint, f"link '{child.get('link')}' already has a parent joint")
-        by_child[child.get("link")] = joint
+    for joint in robot.joints:
+        if joint.name in joint_names:
+            raise source.fail(joint.at, f"joint '{joint.name}' is defined twice, differently")
+        joint_names.add(joint.name)
+        for end, link in (("parent", joint.parent), ("child", joint.child)):
+            if link is not None and link not in links:
+                raise source.fail(joint.at, f"unknown {end} link '{link}'")
+        if joint.child is None:
+            raise source.fail(joint.at, "a joint needs <child link=...>")
+        if joint.child in by_child:
+            raise source.fail(joint.at, f"link '{joint.child}' already has a parent joint")
+        by_child[joint.child] = joint
     roots = [name for name in links if name not in by_child]
     if not roots:
-        raise source.fail(next(iter(by_child.values())), "the joints form a cycle (no root link)")
+        raise source.fail(
+            next(iter(by_child.values())).at, "the joints form a cycle (no root link)"
+        )
     if len(roots) > 1:
-        raise source.fail(links[roots[1]], f"links {roots[:3]} have no parent: more than one root")
+        raise source.fail(
+            links[roots[1]].at, f"links {roots[:3]} have no parent: more than one root"
+        )
     reached = {roots[0]}  # every link must reach the root; each link is walked once
     for name in links:
         path, at = {}, name  # an insertion-ordered set: linear in the chain's length
         while at not in reached:
             if at in path:
-                raise source.fail(by_child[at], "the joints form a cycle")
+                raise source.fail(by_child[at].at, "the joints form a cycle")
             path[at] = None
-            at = by_child[at].find("parent").get("link")
+            at = by_child[at].parent
         reached.update(path)
     return links, by_child, roots[0]
 
@@ -73,11 +74,11 @@ def tree(source: Source) -> tuple[dict, dict, str]:
 def _children(by_child: dict) -> dict[str, list[str]]:
     out: dict[str, list[str]] = {}
     for child, joint in by_child.items():
-        out.setdefault(joint.find("parent").get("link"), []).append(child)
+        out.setdefault(joint.parent, []).append(child)
     return out
 
 
-def _loads(source, links, kids, by_child, root) -> dict[str, tuple[float, float]]:
+def _loads(links, kids, by_child, root) -> dict[str, tuple[float, float]]:
     """Per link: mass (kg) of its subtree and a lever arm (m), the longest chain of joint
     offsets below it or CoM offset (a long link without children, such as a neck, holds its
     CoM that far; at least 0.1 m). Children before parents, without recursion: a chain of
@@ -90,19 +91,13 @@ def _loads(source, links, kids, by_child, root) -> dict[str, tuple[float, float]
     out: dict[str, tuple[float, float]] = {}
     for name in reversed(order):
         mass, arm = 0.0, 0.0
-        if has_mass(links[name]):
-            mass = floats(source, links[name].find("inertial/mass"), "value", 1)
-            com = links[name].find("inertial/origin")  # its own CoM is a lever arm too
-            if com is not None:
-                arm = float(np.linalg.norm(floats(source, com, "xyz", 3, "0 0 0")))
+        link = links[name]
+        if has_mass(link):
+            mass = link.inertial.mass
+            arm = float(np.linalg.norm(link.inertial.origin.xyz))  # its own CoM is a lever arm
         for child in kids.get(name, []):
             sub_mass, sub_arm = out[child]
-            xyz = by_child[child].find("origin")
-            offset = (
-                0.0
-                if xyz is None
-                else float(np.linalg.norm(floats(source, xyz, "xyz", 3, "0 0 0")))
-            )
+            offset = float(np.linalg.norm(by_child[child].origin.xyz))
             mass += sub_mass
             arm = max(arm, offset + sub_arm)
         out[name] = (mass, max(arm, 0.1))
@@ -116,18 +111,17 @@ def _frame_links(links, by_child, kids, root) -> set[str]:
         for name, link in links.items()
         if name != root
         and not kids.get(name)
-        and by_child[name].get("type") == "fixed"
+        and by_child[name].type == "fixed"
         and not has_mass(link)
         and not has_geometry(link)
     }
 
 
 def materials_of(source: Source) -> dict[str, tuple]:
-    out = {}
-    for material in source.root.iter("material"):
-        colour = material.find("color")
-        if material.get("name") and colour is not None:
-            out.setdefault(material.get("name"), floats(source, colour, "rgba", 4))
+    """Each named material's colour (the first of a name), anywhere in the document."""
+    out: dict[str, tuple] = {}
+    for material in source.robot.materials:
+        out.setdefault(material.name, material.rgba)
     return out
 
 
@@ -142,8 +136,8 @@ def convert(
 ) -> dict:
     """The spec dict for the whole robot. `density` (kg/m^3): massless links with a solid
     get its mass at it (`_estimated_mass`; None: the placeholder speck)."""
-    for element in source.root:
-        if isinstance(element.tag, str) and element.tag not in TOP + URDF_BLOCK_TAGS:
+    for element in source.robot.others:
+        if element.tag not in URDF_BLOCK_TAGS:
             report.dropped(
                 source, element, "simkit writes its own (URDF, MJCF, ros2_control, SRDF)"
             )
@@ -151,7 +145,7 @@ def convert(
     links, by_child, root = tree(source)
     kids = _children(by_child)
     frames = _frame_links(links, by_child, kids, root)
-    loads = _loads(source, links, kids, by_child, root)
+    loads = _loads(links, kids, by_child, root)
     materials, colours = materials_of(source), {}
     root_is_frame = not has_mass(links[root]) and not has_geometry(links[root]) and not floating
     spec_links, spec_joints, spec_frames = [], [], []
@@ -161,7 +155,7 @@ def convert(
         spec_joints.append(
             {"name": f"{root}_{joint_type}", "type": joint_type, "parent": spec_root, "child": root}
         )
-    drawn = any(link.find("visual") is not None for link in links.values())
+    drawn = any(link.visuals for link in links.values())
     for link_name in links:  # document order
         if link_name == spec_root:
             continue
@@ -190,16 +184,16 @@ def convert(
         )
         if link_name in by_child:
             spec_joints.append(joint_spec(source, by_child[link_name], report, loads[link_name]))
-    if floating and source.root.find("link/collision") is None:
-        if source.root.find("link/visual") is None:
+    if floating and not any(link.collisions for link in source.robot.links):
+        if not any(link.visuals for link in source.robot.links):
             _estimated_solids(source, spec_links, spec_joints, report)
         else:
             _visual_collision(source, spec_links, report)
     if floating and has_mass(links[root]) is False and not has_geometry(links[root]):
-        report.changed(source, links[root], "massless root of a floating base")
+        report.changed(source, links[root].at, "massless root of a floating base")
     spec: dict = {
         "name": name,
-        "title": one_line(source.root.get("name") or name),
+        "title": one_line(source.robot.name or name),
         "description": f"Imported from {one_line(source.path.name)} by simkit import.",
         "sources": [one_line(source.path.name)],
         "root": spec_root,
@@ -252,7 +246,7 @@ def _estimated_mass(name: str, links: dict, by_child: dict) -> bool:
         return False
     if not any(has_mass(link) for link in links.values()):
         return True
-    return name in by_child and by_child[name].get("type") not in ("fixed", None)
+    return name in by_child and by_child[name].type not in ("fixed", "")
 
 
 def _visual_collision(source: Source, spec_links: list[dict], report: Report) -> None:
@@ -269,7 +263,7 @@ def _visual_collision(source: Source, spec_links: list[dict], report: Report) ->
     if done:
         report.estimated(
             source,
-            source.root,
+            source.robot.at,
             f"no <collision> in the {source.noun}: {done} links collide with their visual solid's "
             "convex hull (a floating base needs something to stand on)",
         )
@@ -282,7 +276,7 @@ def _estimated_solids(source: Source, links: list[dict], joints: list[dict], rep
     if done:
         report.estimated(
             source,
-            source.root,
+            source.robot.at,
             f"no <visual> or <collision> in the {source.noun}: {done} links with a mass get a box "
             f"spanning their origin, child joints and CoM, as thick as holds the mass at "
             f"{DENSITY:g} kg/m^3 up to {MAX_SIDE:g} m (solid and collision; a floating base "
@@ -299,16 +293,21 @@ def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
         if mimic is not None and (mimic["joint"] not in movable or mimic["joint"] == joint["name"]):
             del joint["mimic"]
             joint.pop("actuated", None)
-            element = source.root.find(f"joint[@name='{joint['name']}']/mimic")
             report.dropped(
                 source,
-                element if element is not None else source.root,
+                _mimic_at(source, joint["name"]),
                 f"mimic of '{mimic['joint']}', not a movable joint: imported as independent",
             )
     first_leaders(source, joints, report)
     for joint in joints:
         if "mimic" in joint:
             mimic_limits(source, joint, movable[joint["mimic"]["joint"]], report)
+
+
+def _mimic_at(source: Source, name: str):
+    """Where the source's joint `name` gives its `<mimic>` (its robot, when it does not)."""
+    joint = source.robot.joint(name)
+    return joint.mimic.at if joint is not None and joint.mimic is not None else source.robot.at
 
 
 def _ancestors(tool: str | None, joints: list[dict], frames: list[dict]) -> set[str]:
@@ -346,10 +345,10 @@ def _report_mid_range(source: Source, movable: list[dict], home: dict, report: R
     limits (a mimic follower follows its leader: none)."""
     for j in movable:
         if home[j["name"]] != 0.0 and "mimic" not in j:
-            element = source.root.find(f"joint[@name='{j['name']}']")
+            found = source.robot.joint(j["name"])
             report.assumed(
                 source,
-                source.root if element is None else element,
+                source.robot.at if found is None else found.at,
                 f"home: {home[j['name']]:.4g}, the middle of its range {j['lower']:.4g} .. "
                 f"{j['upper']:.4g} (the {source.noun}'s zero pose is outside it)",
             )

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from simkit.importer.diagnostics import Report
+from simkit.importer.read.model import At
 from simkit.importer.read.source import Source
 from simkit.spec.schema import InertiaSpec
 from simkit.spec.validate import mujoco_refuses
@@ -20,9 +21,10 @@ NUDGE = 1e-6
 KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 
 
-def nudge(source: Source, element, out: dict, report: Report) -> None:
+def nudge(source: Source, element: At | None, out: dict, report: Report) -> None:
     """Raise `out["inertia"]` (a spec inertia dict, kg m^2) off the limit when it is physical
-    within the spec's tolerance but MuJoCo refuses it; one report line."""
+    within the spec's tolerance but MuJoCo refuses it; one report line at `element` (the
+    source's inertia)."""
     inertia = out["inertia"]
     values = [float(inertia.get(k, 0.0)) for k in KEYS]
     tensor = np.array(

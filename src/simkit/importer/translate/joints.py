@@ -1,83 +1,79 @@
-"""URDF `<joint>` to a spec joint: type, origin, axis, limits, dynamics, mimic."""
+"""A source model joint (a URDF `<joint>`) to a spec joint: type, origin, axis, limits,
+dynamics, mimic."""
 
 from __future__ import annotations
 
 import math
 
 from simkit.importer.diagnostics import Report
+from simkit.importer.read.model import Joint
 from simkit.importer.read.source import Source
-from simkit.importer.translate.geometry import floats, origin, placed
+from simkit.importer.translate.geometry import placed
 from simkit.spec.bounds import FIELD_BOUNDS, TURNS
 
 TYPES = {"revolute", "continuous", "prismatic", "fixed", "floating"}
-KNOWN = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 #: rad/s and m/s given to a joint without a velocity limit
 VELOCITY = {"revolute": 3.0, "continuous": 3.0, "prismatic": 0.5}
 G = 9.81
 
 
-def joint_spec(source: Source, joint, report: Report, load: tuple[float, float]) -> dict:
-    """The spec dict of one joint. `load` = (mass, lever arm in m) of what it carries, for an
-    effort the URDF does not give."""
-    kind = joint.get("type", "")
-    name = joint.get("name")
+def joint_spec(source: Source, joint: Joint, report: Report, load: tuple[float, float]) -> dict:
+    """The spec dict of one joint (a source model `Joint`). `load` = (mass, lever arm in m)
+    of what it carries, for an effort the source does not give."""
+    kind = joint.type
     if kind == "planar":
-        raise source.fail(joint, "planar joints are not supported")
+        raise source.fail(joint.at, "planar joints are not supported")
     if kind not in TYPES:
-        raise source.fail(joint, f"unknown joint type '{kind}'")
-    parent, child = joint.find("parent"), joint.find("child")
-    if parent is None or child is None or not parent.get("link") or not child.get("link"):
-        raise source.fail(joint, "a joint needs <parent link=...> and <child link=...>")
-    for element in joint:
-        if isinstance(element.tag, str) and element.tag not in KNOWN:
-            report.dropped(source, element, f"not {source.a_noun} joint element simkit keeps")
-    xyz, rpy = origin(source, joint)
+        raise source.fail(joint.at, f"unknown joint type '{kind}'")
+    if not joint.parent or not joint.child:
+        raise source.fail(joint.at, "a joint needs <parent link=...> and <child link=...>")
+    for element in joint.unknown:
+        report.dropped(source, element, f"not {source.a_noun} joint element simkit keeps")
     spec: dict = {
-        "name": name,
+        "name": joint.name,
         "type": kind,
-        "parent": parent.get("link"),
-        "child": child.get("link"),
-        **placed(xyz, rpy),
+        "parent": joint.parent,
+        "child": joint.child,
+        **placed(joint.origin.xyz, joint.origin.rpy),
     }
     if kind in ("fixed", "floating"):
         return spec
-    axis_el = joint.find("axis")
-    axis = (1.0, 0.0, 0.0) if axis_el is None else floats(source, axis_el, "xyz", 3, "1 0 0")
+    axis = (1.0, 0.0, 0.0) if joint.axis is None else joint.axis
     if math.sqrt(sum(a * a for a in axis)) < 1e-9:
-        raise source.fail(axis_el, "joint axis must not be zero")
+        raise source.fail(joint.axis_at, "joint axis must not be zero")
     spec["axis"] = list(axis)
+    limit_at = None if joint.limit is None else joint.limit.at
     if kind == "revolute" and _unbounded(joint):
         kind = spec["type"] = "continuous"
         report.changed(
             source,
-            joint.find("limit"),
+            limit_at,
             f"revolute limits beyond {TURNS} turns (a placeholder for none, e.g. a rotor): "
             "imported as continuous",
         )
     elif kind == "revolute" and _reversed(joint):
         kind = spec["type"] = "continuous"
         source.lenient(
-            joint.find("limit"),
-            "lower > upper, which Bullet reads as no limit: imported as continuous",
+            limit_at, "lower > upper, which Bullet reads as no limit: imported as continuous"
         )
     estimated: list[str] = []
     spec.update(_limits(source, joint, kind, report, load, estimated))
-    dynamics = joint.find("dynamics")
+    dynamics = joint.dynamics
     if dynamics is not None:
         for key in ("damping", "friction"):
-            value = floats(source, dynamics, key, 1, "0")
+            value = getattr(dynamics, key) or 0.0
             if value < 0:
-                raise source.fail(dynamics, f"{key} must be >= 0, got {value}")
+                raise source.fail(dynamics.at, f"{key} must be >= 0, got {value}")
             if value:
                 spec[key] = value
-    mimic = joint.find("mimic")
+    mimic = joint.mimic
     if mimic is not None:
-        if not mimic.get("joint"):
-            raise source.fail(mimic, "mimic needs a 'joint'")
+        if not mimic.joint:
+            raise source.fail(mimic.at, "mimic needs a 'joint'")
         spec["mimic"] = {
-            "joint": mimic.get("joint"),
-            "multiplier": floats(source, mimic, "multiplier", 1, "1"),
-            "offset": floats(source, mimic, "offset", 1, "0"),
+            "joint": mimic.joint,
+            "multiplier": mimic.multiplier,
+            "offset": mimic.offset,
         }
         spec["actuated"] = False  # it follows its leader (MJCF equality), no servo of its own
     if estimated:
@@ -86,17 +82,17 @@ def joint_spec(source: Source, joint, report: Report, load: tuple[float, float])
 
 
 def _limits(
-    source: Source, joint, kind: str, report: Report, load: tuple[float, float], estimated: list
+    source: Source, joint: Joint, kind: str, report: Report, load: tuple[float, float], estimated
 ) -> dict:
-    limit = joint.find("limit")
+    limit = joint.limit
     out: dict = {}
-    element = limit if limit is not None else joint
+    element = limit.at if limit is not None else joint.at
     if kind != "continuous":
-        lower = None if limit is None else limit.get("lower")
-        upper = None if limit is None else limit.get("upper")
-        same = lower is not None and upper is not None and _num(lower) == _num(upper)
+        lower = None if limit is None else limit.lower
+        upper = None if limit is None else limit.upper
+        same = lower is not None and upper is not None and lower == upper
         if _reversed(joint):  # a prismatic one (a revolute one became continuous)
-            source.lenient(limit, "lower > upper, which Bullet reads as no limit")
+            source.lenient(element, "lower > upper, which Bullet reads as no limit")
         if (lower is None and upper is None) or same or _reversed(joint):
             span = math.pi if kind == "revolute" else 0.1
             unit = "rad" if kind == "revolute" else "m"
@@ -105,11 +101,11 @@ def _limits(
             out["lower"], out["upper"] = -span, span
             estimated += ["lower", "upper"]
         else:
-            out["lower"] = floats(source, limit, "lower", 1, "0")
-            out["upper"] = floats(source, limit, "upper", 1, "0")
+            out["lower"] = 0.0 if lower is None else lower
+            out["upper"] = 0.0 if upper is None else upper
             if out["lower"] > out["upper"]:
-                raise source.fail(limit, f"lower ({out['lower']}) is greater than upper")
-    velocity = 0.0 if limit is None else floats(source, limit, "velocity", 1, "0")
+                raise source.fail(element, f"lower ({out['lower']}) is greater than upper")
+    velocity = 0.0 if limit is None or limit.velocity is None else limit.velocity
     if velocity < 0 or velocity > FIELD_BOUNDS["max_velocity"][1]:  # -1, 1000: no real limit
         report.estimated(
             source, element, f"velocity {velocity:g} is a placeholder: {VELOCITY[kind]:g}"
@@ -122,7 +118,7 @@ def _limits(
             report.estimated(source, element, f"no velocity limit: {velocity:g}")
             estimated.append("max_velocity")
     out["max_velocity"] = velocity
-    effort = 0.0 if limit is None else floats(source, limit, "effort", 1, "0")
+    effort = 0.0 if limit is None or limit.effort is None else limit.effort
     if effort < 0 or effort > FIELD_BOUNDS["effort_peak"][1]:  # -1, 1e30: no real limit
         report.estimated(source, element, f"effort {effort:g} is a placeholder")
         effort = 0.0
@@ -139,31 +135,22 @@ def _limits(
     return out
 
 
-def _unbounded(joint) -> bool:
+def _unbounded(joint: Joint) -> bool:
     """A revolute joint whose lower or upper limit lies beyond TURNS turns (a multirotor's
-    rotors give +-1e16): the URDF's way of saying it has none."""
-    limit = joint.find("limit")
+    rotors give +-1e16): the source's way of saying it has none."""
+    limit = joint.limit
     if limit is None:
         return False
-    values = [_num(limit.get(key, "0")) for key in ("lower", "upper")]
-    return any(v is not None and abs(v) > TURNS * 2 * math.pi for v in values)
+    return any(v is not None and abs(v) > TURNS * 2 * math.pi for v in (limit.lower, limit.upper))
 
 
-def _reversed(joint) -> bool:
-    """A `<limit>` whose lower exceeds its upper (a corpus cube: 1 > -1): Bullet
-    reads it as no limit."""
-    limit = joint.find("limit")
+def _reversed(joint: Joint) -> bool:
+    """A `<limit>` whose lower exceeds its upper (a corpus cube: 1 > -1; one not given reads
+    0): Bullet reads it as no limit."""
+    limit = joint.limit
     if limit is None:
         return False
-    lower, upper = _num(limit.get("lower", "0")), _num(limit.get("upper", "0"))
-    return lower is not None and upper is not None and lower > upper
-
-
-def _num(text: str) -> float | None:
-    try:
-        return float(text)
-    except ValueError:
-        return None
+    return (limit.lower or 0.0) > (limit.upper or 0.0)
 
 
 def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> None:
@@ -180,10 +167,10 @@ def mimic_limits(source: Source, joint: dict, leader: dict, report: Report) -> N
     tol = 1e-9 * max(1.0, abs(lower), abs(upper))
     if lower >= joint["lower"] - tol and upper <= joint["upper"] + tol:
         return
-    element = source.root.find(f"joint[@name='{joint['name']}']")
+    found = source.robot.joint(joint["name"])
     report.estimated(
         source,
-        element if element is not None else source.root,
+        source.robot.at if found is None else found.at,
         f"limits {joint['lower']:g}..{joint['upper']:g} do not hold the range of its mimic "
         f"('{m['joint']}' {leader['lower']:g}..{leader['upper']:g} x {m['multiplier']:g} + "
         f"{m['offset']:g}): {lower:g}..{upper:g}",
@@ -214,8 +201,8 @@ def first_leaders(source: Source, joints: list[dict], report: Report) -> None:
                 multiplier * step["offset"] + offset,
             )
             leader = step["joint"]
-        element = source.root.find(f"joint[@name='{joint['name']}']/mimic")
-        element = element if element is not None else source.root
+        found = source.robot.joint(joint["name"])
+        element = found.mimic.at if found is not None and found.mimic else source.robot.at
         if leader in seen:
             del joint["mimic"]
             joint.pop("actuated", None)

@@ -1,4 +1,4 @@
-"""URDF `<link>` to a spec link: inertial, geometry, colour and collision choice."""
+"""A source model `Link` to a spec link: inertial, geometry, colour and collision choice."""
 
 from __future__ import annotations
 
@@ -7,9 +7,10 @@ import math
 import numpy as np
 
 from simkit.importer.diagnostics import Report
+from simkit.importer.read.model import Geometry, Link
 from simkit.importer.read.source import Source
 from simkit.importer.translate import inertia_limit, points
-from simkit.importer.translate.geometry import floats, origin, shape_of
+from simkit.importer.translate.geometry import shape_of
 from simkit.importer.translate.masses import solid_mass
 from simkit.importer.translate.meshes import MeshWriter
 from simkit.model.kinematics import rpy_matrix
@@ -23,20 +24,16 @@ MASSLESS_MASS, MASSLESS_INERTIA = 0.001, 1.0e-7
 MIN_MASS = FIELD_BOUNDS["mass"][0]
 #: kg/m^3 of the solid sphere whose inertia replaces a zero one
 DENSITY = 1000.0
-KNOWN = {"inertial", "visual", "collision"}
 
 
-def has_mass(link) -> bool:
-    """True when the link's `<inertial>` gives a positive mass."""
-    mass = link.find("inertial/mass")
-    try:
-        return mass is not None and float(mass.get("value", "0")) > 0
-    except ValueError:
-        return False
+def has_mass(link: Link) -> bool:
+    """True when the link's inertial gives a positive mass."""
+    return link.massive
 
 
-def has_geometry(link) -> bool:
-    return link.find("visual") is not None or link.find("collision") is not None
+def has_geometry(link: Link) -> bool:
+    """True when the link has a visual or a collision."""
+    return link.drawn
 
 
 def _rotated(tensor: np.ndarray, rpy) -> np.ndarray:
@@ -44,13 +41,13 @@ def _rotated(tensor: np.ndarray, rpy) -> np.ndarray:
     return rot @ tensor @ rot.T
 
 
-def inertial(source: Source, link, report: Report) -> dict:
+def inertial(source: Source, link: Link, report: Report) -> dict:
     """mass, com, inertia (about the CoM, link axes) and the estimates and decision made."""
-    element = link.find("inertial")
-    if not has_mass(link):
+    element = link.inertial
+    if element is None or not element.massive:
         report.estimated(
             source,
-            link,
+            link.at,
             f"no positive mass in the {source.noun}: {MASSLESS_MASS} kg, inertia "
             f"{MASSLESS_INERTIA} kg m^2",
         )
@@ -63,16 +60,10 @@ def inertial(source: Source, link, report: Report) -> dict:
             "note": f"massless in the {source.noun}; a small mass keeps MuJoCo's moving bodies "
             "valid",
         }
-    mass = floats(source, element.find("mass"), "value", 1)
-    xyz, rpy = origin(source, element)
-    tag = element.find("inertia")
-    if tag is None:
-        values = (0.0,) * 6
-    else:
-        values = tuple(
-            floats(source, tag, k, 1, "0") for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
-        )
-    ixx, iyy, izz, ixy, ixz, iyz = values
+    mass = element.mass
+    xyz, rpy = element.origin.xyz, element.origin.rpy
+    tag = element.inertia_at if element.inertia is not None else None
+    ixx, iyy, izz, ixy, ixz, iyz = element.inertia or (0.0,) * 6
     tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
     if any(rpy):
         tensor = _rotated(tensor, rpy)
@@ -84,7 +75,7 @@ def inertial(source: Source, link, report: Report) -> dict:
         flat = (tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2])
         report.estimated(
             source,
-            element.find("mass"),
+            element.mass_at,
             f"mass {out['mass']:g} kg is too small to simulate: {MIN_MASS:g} kg, inertia "
             "scaled by the same factor (same radius of gyration)",
         )
@@ -94,7 +85,7 @@ def inertial(source: Source, link, report: Report) -> dict:
         moment = 0.4 * mass * radius * radius
         report.estimated(
             source,
-            tag if tag is not None else element,
+            tag if tag is not None else element.at,
             f"zero inertia: a {DENSITY:g} kg/m^3 solid sphere of that mass ({moment:.3g} kg m^2)",
         )
         out["inertia"] = {"ixx": moment, "iyy": moment, "izz": moment}
@@ -114,19 +105,19 @@ def inertial(source: Source, link, report: Report) -> dict:
     return out
 
 
-def _colour(source: Source, visual, materials: dict[str, tuple]) -> tuple | None:
-    element = visual.find("material")
-    if element is None:
+def _colour(visual: Geometry, materials: dict[str, tuple]) -> tuple | None:
+    """A visual's rgba (0..1): its material's own colour, else the named material's."""
+    material = visual.material
+    if material is None:
         return None
-    colour = element.find("color")
-    if colour is not None:
-        return floats(source, colour, "rgba", 4)
-    return materials.get(element.get("name", ""))
+    if material.rgba is not None:
+        return material.rgba
+    return materials.get(material.name or "")
 
 
 def link_spec(
     source: Source,
-    link,
+    link: Link,
     writer: MeshWriter,
     report: Report,
     materials: dict[str, tuple],
@@ -140,39 +131,39 @@ def link_spec(
     `volume_mass`: a link without a visual may take its mass from its collision geometry
     (False where other links have visuals: such a link's collision geometry is a safety
     volume around a body, such as a capsule about an arm link, not a body; issue 32)."""
-    name = link.get("name")
-    spec: dict = {"name": name}
+    spec: dict = {"name": link.name}
     if has_mass(link) or density is None:
         spec.update(inertial(source, link, report))
-    for child in link:
-        if isinstance(child.tag, str) and child.tag not in KNOWN:
-            report.dropped(source, child, f"not {source.a_noun} link element simkit keeps")
+    for child in link.unknown:
+        report.dropped(source, child, f"not {source.a_noun} link element simkit keeps")
     visuals, rgba = [], None
-    for visual in link.findall("visual"):
-        got = shape_of(source, visual, writer, report, "visual")
+    for visual in link.visuals:
+        got = shape_of(source, visual, link, writer, report, "visual")
         if got is None:
             continue
         shape, info = got
         visuals.append(shape)
         if info is not None and info.repair == "hull":
-            report.changed(source, visual, f"{shape['file']}: open mesh, its convex hull is used")
-        colour = _colour(source, visual, materials) or (info.rgba if info else None)
+            report.changed(
+                source, visual.at, f"{shape['file']}: open mesh, its convex hull is used"
+            )
+        colour = _colour(visual, materials) or (info.rgba if info else None)
         if colour is not None and rgba is not None and tuple(map(float, colour)) != rgba:
             report.changed(  # a kit link is one solid with one material
                 source,
-                visual,
+                visual.at,
                 f"colour {' '.join(f'{c:g}' for c in colour)}: the link's solid takes its "
                 f"first visual's colour, {' '.join(f'{c:g}' for c in rgba)}",
             )
         if rgba is None and colour is not None:
             rgba = tuple(float(c) for c in colour)
     collisions, sources = [], []
-    for element in link.findall("collision"):
-        got = shape_of(source, element, writer, report, "collision")
+    for collision in link.collisions:
+        got = shape_of(source, collision, link, writer, report, "collision")
         if got is not None:
             collisions.append(got[0])
-            sources.append(element.get(PIECE_OF) or f"#{len(sources)}")
-    if points.grown(source, link, collisions, report):
+            sources.append(collision.piece_of or f"#{len(sources)}")
+    if points.grown(source, link.at, collisions, report):
         spec["estimated"] = [*spec.get("estimated", []), "collision_primitives"]
     solid = visuals
     weighed = "mass" not in spec and (bool(visuals) or volume_mass)
@@ -180,7 +171,7 @@ def link_spec(
         solid = collisions
         report.changed(
             source,
-            link,
+            link.at,
             "no visual: the collision geometry is the visual solid"
             + ("" if weighed or "mass" in spec else " (a safety volume: no mass from it)"),
         )
@@ -197,12 +188,14 @@ def link_spec(
     chosen = _collision(collisions, sources)
     if hull_collision and chosen["collision"] in ("given", "auto"):
         chosen = {"collision": "mesh"}
-        report.changed(source, link, "collision meshes: the visual solid's convex hull (--hull)")
+        report.changed(source, link.at, "collision meshes: the visual solid's convex hull (--hull)")
     spec.update(chosen)
     return spec
 
 
-def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dict:
+def _from_solid(
+    source: Source, link: Link, report: Report, solid, writer: MeshWriter, density
+) -> dict:
     """A massless link's mass, CoM and inertia: its visual solid's at `density` (kg/m^3),
     estimated and reported; the placeholder speck (`inertial`) where it has no volume."""
     found = solid_mass(solid, writer.out_dir, density) if solid else None
@@ -211,7 +204,7 @@ def _from_solid(source, link, report, solid, writer: MeshWriter, density) -> dic
     mass, com, tensor, volume, what = found
     report.estimated(
         source,
-        link,
+        link.at,
         f"no mass in the {source.noun}: {mass:.4g} kg, its visual solid's volume "
         f"({volume:.4g} m^3, "
         f"{what}) at {density:g} kg/m^3 (--density); CoM and inertia of that solid",
@@ -233,18 +226,14 @@ MAX_GIVEN = 10
 #: (derive/collision.py `merge_greedy`, quadratic in them: 48 pieces took 7.5 s, cover
 #: included, where CoACD takes about 4 s a link); the spec allows 1000 (spec/bounds.py)
 MAX_GIVEN_PIECES = 64
-#: a `<collision>` attribute a reader sets on the convex pieces of one source (a USD's
-#: sibling collision meshes under one grouping prim: formats/usd/shapes.py), the same value
-#: on each: they count once against MAX_GIVEN. A URDF's elements never carry it.
-PIECE_OF = "simkit-piece-of"
 PRIMITIVES = {"box", "cylinder", "sphere", "capsule"}
 
 
 def _collision(collisions: list[dict], sources: list[str]) -> dict:
     """Primitives stay primitives; the meshes of up to MAX_GIVEN sources (`sources`: each
-    collision's source, PIECE_OF or its own), MAX_GIVEN_PIECES pieces in all, are kept, one
-    convex piece each (`given`); more go to the cached CoACD path (`auto`); none means no
-    collision geometry."""
+    collision's source, its `piece_of` or its own: the pieces of one source count once),
+    MAX_GIVEN_PIECES pieces in all, are kept, one convex piece each (`given`); more go to
+    the cached CoACD path (`auto`); none means no collision geometry."""
     if all(c["shape"] in PRIMITIVES for c in collisions):
         return {"collision": "primitives", "collision_primitives": collisions}
     if len(set(sources)) <= MAX_GIVEN and len(collisions) <= MAX_GIVEN_PIECES:

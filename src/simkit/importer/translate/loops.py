@@ -1,14 +1,13 @@
 """A link with two parent joints (a closed kinematic loop): one rule for every format.
 
 A source whose link hangs from two joints (an end effector fixed both to the arm and to the
-world, a four-bar) is a closed loop, which a kit's tree cannot hold. Every reader gives the
-importer a URDF-shaped document (`Source.root`: `<link>`s and `<joint>`s), and every format
-applies this rule to it (formats/urdf/repairs.py `second_parents` names it, so xacro and
-the readers of other formats call it too):
+world, a four-bar) is a closed loop, which a kit's tree cannot hold. Every format applies
+this rule:
 
-- `second_parents` (on the document, before the tree is read): the tree is built from the
-  link's first joint in document order; each later joint is taken out of the tree, one
-  report line each, and kept as a closure (`Source.closures`);
+- `second_parents` (formats/urdf/repairs.py, on the URDF-shaped document every reader
+  builds, before the source model is read): the tree is built from the link's first joint
+  in document order; each later joint is taken out of the tree, one report line each, and
+  kept as a closure (`Source.closures`, source model joints once read);
 - `close` (a step after the names are made legal): each closure becomes a spec `loops`
   entry of type `weld` between the joint's parent and child links (a massless frame's
   holder link in its place), at the pose the tree puts the child in the parent's frame
@@ -28,43 +27,9 @@ import re
 
 import numpy as np
 
-from simkit.importer.diagnostics import Report
 from simkit.importer.draft import Draft
-from simkit.importer.read.source import Source
 from simkit.model.kinematics import forward, matrix_rpy
 from simkit.spec.names import MAX_NAME, name_problem
-
-
-def second_parents(source: Source, report: Report) -> None:
-    """Take each `<joint>` whose child link already has a parent joint earlier in the
-    document out of the tree (a closed loop), one report line each, and keep it in
-    `source.closures`; the first joint builds the tree."""
-    first: dict[str, object] = {}
-    for joint in source.root.findall("joint"):
-        child = joint.find("child")
-        link = None if child is None else child.get("link")
-        if link is None:
-            continue  # refused by tree(), naming the joint
-        if link not in first:
-            first[link] = joint
-            continue
-        said = loop_reason(first[link], link)
-        kind = joint.get("type") or "fixed"
-        if kind != "fixed":  # a four-bar's pin: the kit holds it rigid (no `connect` yet)
-            said += f"; its {kind} motion is locked (a weld holds all six degrees of freedom)"
-        report.changed(source, joint, said)
-        source.closures.append(joint)
-        source.root.remove(joint)
-
-
-def loop_reason(first, link: str) -> str:
-    """The one line on a joint taken out of the tree because `link` hangs from `first`."""
-    return (
-        f"link '{link}' already has a parent joint '{first.get('name')}' (line "
-        f"{first.sourceline or '?'}): a closed loop; the kit keeps the tree from the first "
-        "joint and closes the loop with a weld (spec `loops`) at the pose the tree gives "
-        "at home"
-    )
 
 
 def close(draft: Draft) -> None:
@@ -73,27 +38,25 @@ def close(draft: Draft) -> None:
     holders = _holders(draft.spec)
     names = {j["name"] for j in draft.spec["joints"]}
     loops = []
-    for joint in draft.source.closures:
-        parent, child = joint.find("parent"), joint.find("child")
+    for joint in draft.source.closures:  # source model joints (read/model.py)
         ends = []
-        for end in (parent, child):
-            old = None if end is None else end.get("link")
+        for old in (joint.parent, joint.child):
             new = renamed.get("links", {}).get(old) or renamed.get("frames", {}).get(old) or old
             ends.append(holders.get(new, new))
         link1, link2 = ends
         why = _unclosable(draft.spec, link1, link2)
-        listed = joint.get("listed")  # a format's own element (an MJCF weld), listed so
+        listed = joint.listed  # a format's own element (an MJCF weld), listed so
         if why:
-            draft.report.dropped(draft.source, joint, f"a closed loop with {why}")
+            draft.report.dropped(draft.source, joint.at, f"a closed loop with {why}")
             if listed:
                 draft.listed.append((listed, f"left out: {why}"))
             continue
-        name = _free(renamed.get("joints", {}).get(joint.get("name")) or joint.get("name"), names)
+        name = _free(renamed.get("joints", {}).get(joint.name) or joint.name, names)
         names.add(name)
         loops.append({"name": name, "type": "weld", "link1": link1, "link2": link2})
         if listed:
             said = f"closed by a weld (spec `loops` '{name}') at the pose the tree gives at home"
-            draft.report.changed(draft.source, joint, f"'{link2}' welded to '{link1}': {said}")
+            draft.report.changed(draft.source, joint.at, f"'{link2}' welded to '{link1}': {said}")
             draft.listed.append((listed, said))
     if loops:
         draft.spec["loops"] = loops

@@ -9,6 +9,7 @@ import itertools
 import math
 
 from simkit.importer.diagnostics import Report
+from simkit.importer.read.model import At
 from simkit.importer.read.source import Source
 
 #: the radius is this fraction of the largest distance between the link's contact points
@@ -33,9 +34,10 @@ def radius_of(points: list[dict]) -> tuple[float, float]:
     return max(FLOOR, round(SPAN_FRACTION * span, 6)), span
 
 
-def grown(source: Source, link, collisions: list[dict], report: Report) -> bool:
-    """Give the link's contact points their radius in place, with one report line; True
-    if there were any (the link's `collision_primitives` is then estimated)."""
+def grown(source: Source, link: At, collisions: list[dict], report: Report) -> bool:
+    """Give the link's contact points their radius in place, with one report line at `link`
+    (where the link is in the source); True if there were any (the link's
+    `collision_primitives` is then estimated)."""
     points = [c for c in collisions if is_point(c)]
     if not points:
         return False

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.read.source import resolve_uri
-from simkit.importer.translate.geometry import floats, origin
+from simkit.importer.read.model import Link
+from simkit.importer.read.source import Source, resolve_uri
 from simkit.importer.translate.meshes import Y_UP_TO_Z_UP, is_y_up
 from simkit.model.kinematics import rpy_matrix
 
@@ -35,16 +35,18 @@ def _vertices(path: Path, scale) -> np.ndarray | None:
     return vertices if len(vertices) else None
 
 
-def _fit(source, link, kids: list[np.ndarray], turn: bool) -> tuple[int, float] | None:
+def _fit(
+    source: Source, link: Link, kids: list[np.ndarray], turn: bool
+) -> tuple[int, float] | None:
     """(child joint origins inside the link's Y_UP visual meshes' bounds, distance m of their
     centroid from the inertial CoM) with the meshes turned or not; None without such a mesh."""
     points = []
-    for visual in link.findall("visual"):
-        mesh = visual.find("geometry/mesh")
-        if mesh is None or not mesh.get("filename"):
+    for visual in link.visuals:
+        mesh = visual.shape
+        if mesh is None or mesh.kind != "mesh" or not mesh.filename:
             continue
         try:
-            path = resolve_uri(source, mesh, mesh.get("filename"))
+            path = resolve_uri(source, mesh.at, mesh.filename)
         except Exception:  # a missing mesh: the import reports it
             continue
         if not is_y_up(path):
@@ -54,33 +56,31 @@ def _fit(source, link, kids: list[np.ndarray], turn: bool) -> tuple[int, float] 
             continue
         if turn:
             vertices = vertices @ Y_UP_TO_Z_UP.T
-        vertices = vertices * np.asarray(floats(source, mesh, "scale", 3, "1 1 1"))
-        xyz, rpy = origin(source, visual)
+        vertices = vertices * np.asarray(mesh.scale)
+        xyz, rpy = visual.origin.xyz, visual.origin.rpy
         points.append(vertices @ rpy_matrix(rpy).T + np.asarray(xyz))
     if not points:
         return None
     every = np.vstack(points)
     low, high = every.min(axis=0) - SLACK, every.max(axis=0) + SLACK
     inside = sum(bool(np.all((k >= low) & (k <= high))) for k in kids)
-    com = link.find("inertial/origin")
-    centre = np.zeros(3) if com is None else np.asarray(floats(source, com, "xyz", 3, "0 0 0"))
+    centre = np.asarray(link.inertial.origin.xyz if link.inertial else (0.0, 0.0, 0.0))
     return inside, float(np.linalg.norm(every.mean(axis=0) - centre))
 
 
-def turn_y_up(source) -> tuple[bool, str]:
-    """Whether this URDF's Y_UP COLLADA meshes are to be turned Z-up, and why (a report
-    line; empty when they stay as stored)."""
+def turn_y_up(source: Source) -> tuple[bool, str]:
+    """Whether this source's Y_UP COLLADA meshes are to be turned Z-up, and why (a report
+    line; empty when they stay as stored). Reads `source.robot`."""
     kids: dict[str, list[np.ndarray]] = {}
-    for joint in source.root.findall("joint"):
-        parent = joint.find("parent")
-        if parent is not None:
-            kids.setdefault(parent.get("link"), []).append(np.asarray(origin(source, joint)[0]))
+    for joint in source.robot.joints:
+        if joint.parent is not None:
+            kids.setdefault(joint.parent, []).append(np.asarray(joint.origin.xyz))
     fits = {False: [0, 0.0, 0], True: [0, 0.0, 0]}
-    for link in source.root.findall("link"):
-        if link.find("inertial") is None:
+    for link in source.robot.links:
+        if link.inertial is None:
             continue
         for turn in (False, True):
-            fit = _fit(source, link, kids.get(link.get("name"), []), turn)
+            fit = _fit(source, link, kids.get(link.name, []), turn)
             if fit is not None:
                 fits[turn][0] += fit[0]
                 fits[turn][1] += fit[1]

@@ -27,7 +27,8 @@ def check(spec_path: Path, spec: dict, source: Source, renames: dict | None = No
 def at_urdf(exc: SpecError, spec: dict, source: Source, renames: dict) -> SpecError:
     """`exc` (about the spec) moved to the URDF element its field names."""
     back = {new: old for table in renames.values() for old, new in table.items()}
-    element = source.root
+    robot = source.robot  # the source model (read/model.py): where each item came from
+    element = robot.at
     match = re.match(r"(links|joints|frames)\[(\d+)\]", exc.field)
     if match and int(match[2]) < len(spec.get(match[1], [])):
         item = spec[match[1]][int(match[2])]
@@ -35,12 +36,12 @@ def at_urdf(exc: SpecError, spec: dict, source: Source, renames: dict) -> SpecEr
         tag = "joint" if match[1] == "joints" else "link"
         if match[1] == "joints" and item.get("parent") == spec.get("root"):
             tag, name = "link", back.get(item["child"], item["child"])  # the added root joint
-        found = next((e for e in source.root.iter(tag) if e.get("name") == name), None)
-        element = found if found is not None else element
+        found = robot.joint(name) if tag == "joint" else robot.link(name)
+        element = found.at if found is not None else element
     elif exc.field == "root":
         name = back.get(spec.get("root", ""), spec.get("root", ""))
-        found = next((e for e in source.root.iter("link") if e.get("name") == name), None)
-        element = found if found is not None else element
+        found = robot.link(name)
+        element = found.at if found is not None else element
     failed = source.fail(element, f"the imported spec's {exc.field}: {exc.message}")
     failed.more = exc.more
     return failed

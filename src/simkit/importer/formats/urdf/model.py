@@ -6,7 +6,8 @@ each one report line (`Source.lenient`, refused with `--strict`); anything else 
 in one line naming the file, line, element and attribute. What the translation never uses
 is not read, so it cannot refuse a file: the inertia of a massless link, the axis, limits,
 dynamics and mimic of a joint that does not move, a fixed or continuous joint's position
-limits. A `<mass>` that is no number reads as massless (as urdfdom's bodies without mass).
+limits, a spherical joint's axis (PyBullet ignores it). A `<mass>` that is no number
+reads as massless (as urdfdom's bodies without mass).
 
 The other formats (MJCF, SDFormat, USD) build a URDF-shaped document from their own model
 and read it here, so the translation has one model to read.
@@ -110,9 +111,7 @@ TOP = ("link", "joint", "material")
 
 def link_of(source: Source, element) -> Link:
     """A `<link>`."""
-    unknown = tuple(
-        At.of(e) for e in element if isinstance(e.tag, str) and e.tag not in LINK_KEEPS
-    )
+    unknown = tuple(At.of(e) for e in element if isinstance(e.tag, str) and e.tag not in LINK_KEEPS)
     return Link(
         element.get("name"),
         At.of(element),
@@ -193,7 +192,7 @@ def joint_of(source: Source, element, deep: bool = True) -> Joint:
     joint = _with(joint, unknown=unknown, listed=element.get("listed"))
     if kind not in MOVING:
         return joint
-    axis = element.find("axis")
+    axis = None if kind == "spherical" else element.find("axis")  # PyBullet ignores it
     moving = {
         "axis": None if axis is None else floats(source, axis, "xyz", 3, "1 0 0"),
         "axis_at": None if axis is None else At.of(axis),
@@ -225,7 +224,9 @@ def _dynamics(source: Source, element) -> Dynamics | None:
     if element is None:
         return None
     return Dynamics(
-        At.of(element), _optional(source, element, "damping"), _optional(source, element, "friction")
+        At.of(element),
+        _optional(source, element, "damping"),
+        _optional(source, element, "friction"),
     )
 
 

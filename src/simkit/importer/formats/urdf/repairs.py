@@ -14,14 +14,14 @@
   ankle): a closed loop, which a kit's tree cannot hold. The tree is built from the link's
   first joint in document order; each later one is closed by a weld (spec `loops`) and
   listed in `source_differences` (`joints.J`, formats/provenance.py): the shared rule of
-  importer/translate/loops.py, which `second_parents` calls.
+  importer/translate/loops.py, whose first half `second_parents` is (every format's reader
+  calls it).
 """
 
 from __future__ import annotations
 
 from simkit.importer.diagnostics import Report
 from simkit.importer.read.source import Source
-from simkit.importer.translate import loops
 
 
 def mounting_frame(source: Source, report: Report) -> str | None:
@@ -85,7 +85,32 @@ def _same(a, b) -> bool:
 
 
 def second_parents(source: Source, report: Report) -> None:
-    """The shared closed-loop rule (importer/translate/loops.py `second_parents`): each
-    later parent joint of a link taken out of the tree and closed by a weld. Kept under
-    this name, which the formats' readers call."""
-    loops.second_parents(source, report)
+    """Take each `<joint>` whose child link already has a parent joint earlier in the
+    document out of the tree (a closed loop), one report line each, and keep it in
+    `source.closures`; the first joint builds the tree."""
+    first: dict[str, object] = {}
+    for joint in source.root.findall("joint"):
+        child = joint.find("child")
+        link = None if child is None else child.get("link")
+        if link is None:
+            continue  # refused by tree(), naming the joint
+        if link not in first:
+            first[link] = joint
+            continue
+        said = loop_reason(first[link], link)
+        kind = joint.get("type") or "fixed"
+        if kind != "fixed":  # a four-bar's pin: the kit holds it rigid (no `connect` yet)
+            said += f"; its {kind} motion is locked (a weld holds all six degrees of freedom)"
+        report.changed(source, joint, said)
+        source.closures.append(joint)
+        source.root.remove(joint)
+
+
+def loop_reason(first, link: str) -> str:
+    """The one line on a joint taken out of the tree because `link` hangs from `first`."""
+    return (
+        f"link '{link}' already has a parent joint '{first.get('name')}' (line "
+        f"{first.sourceline or '?'}): a closed loop; the kit keeps the tree from the first "
+        "joint and closes the loop with a weld (spec `loops`) at the pose the tree gives "
+        "at home"
+    )

@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.usd import poses
 from simkit.importer.formats.urdf.model import PIECE_OF
+from simkit.importer.formats.usd import poses
 
 SHAPES = ("Cube", "Sphere", "Capsule", "Cylinder", "Mesh")
 #: attributes on a `<collision>` holding its shape's MassAPI density and mass until mass.py
