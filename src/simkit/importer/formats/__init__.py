@@ -4,8 +4,10 @@ Each format gives:
 - `sniff(path, head)`: whether the file is of this format (`head`: its first 64 KiB without
   comments and processing instructions, read once by `pick` for every format);
 - `title(head)`: the name the file gives its robot, or None (the spec's default name);
-- `read(shell, options)`: the read `Source` (importer/read/source.py), the one model every
-  format gives the translation, with `kept` (the document as read) and `format` set;
+- `read(shell, options)`: the read `Source` (importer/read/source.py) with its source model
+  `robot` (read/model.py, the one model every format gives the translation; a reader that
+  builds a URDF-shaped document instead leaves it None and `load` reads the document with
+  formats/urdf/model.py), `kept` (the document as read) and `format` set;
 - `keep(draft)`: the kept source written beside the spec and the spec's `source` and
   `source_differences` (formats/provenance.py);
 - `edits` and `after`: the format's own draft steps, run right after the translation
@@ -113,7 +115,8 @@ def load(
     source = read.shell(path, package_dirs, report, options)
     fmt = (picked or pick(path)).format
     done = fmt.read(source, options)
-    done.robot = robot_of(done)  # the source model the translation reads
+    if done.robot is None:  # a reader that built a URDF-shaped document: read it once
+        done.robot = robot_of(done)
     for doc in (done, done.kept):
         doc.format, doc.noun = fmt.name, fmt.noun
     done.original = hashlib.sha256(path.read_bytes()).hexdigest()
