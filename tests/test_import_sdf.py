@@ -18,7 +18,7 @@ from simkit.errors import SpecError
 from simkit.importer import formats
 from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.formats.urdf.document import document
-from simkit.importer.translate import ball_joints
+from simkit.importer.translate import ball_joints, loops
 
 pytest.importorskip("pydrake")
 from simkit.check.source import sdf as proof
@@ -229,7 +229,7 @@ def test_a_static_model_has_a_fixed_base(tmp_path):
 
 def test_closed_loop_keeps_the_first_parent_joint(tmp_path):
     """A link with two parent joints: the tree keeps the first, the second is left out with
-    one report line (formats/urdf/repairs.py second_parents, as for a URDF)."""
+    one report line (translate/loops.py second_parents, on the source model as for a URDF)."""
     path = tmp_path / "loop.sdf"
     path.write_text(
         '<?xml version="1.0"?>\n<sdf version="1.9"><model name="m">'
@@ -243,7 +243,9 @@ def test_closed_loop_keeps_the_first_parent_joint(tmp_path):
     )
     report = Report(Policy())
     read = formats.load(path, report=report)
-    assert [j.get("name") for j in read.root.iter("joint")] == ["ab", "ac"]
+    loops.second_parents(read, report)
+    assert [j.name for j in read.robot.joints] == ["ab", "ac"]
+    assert [j.name for j in read.closures] == ["bc"]
     assert any("closed loop" in line and "bc" in line for line in report.lines)
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from simkit.importer.draft import Draft
-from simkit.importer.translate import base, convert, meshes
+from simkit.importer.translate import base, convert, loops, meshes
 from simkit.importer.translate.up_axis import turn_y_up
 
 
@@ -21,6 +21,7 @@ def to_spec(draft: Draft) -> None:
     """The source to the draft's spec: the base decided, links, joints and frames;
     `draft.meshes` counts the meshes written to the staging folder."""
     source, report = draft.source, draft.report
+    loops.second_parents(source, report)  # a link's later parent joints close loops
     if draft.options.floating is None and source.base is not None:  # the format says
         floating, why = source.base
         draft.options = replace(draft.options, floating=floating)

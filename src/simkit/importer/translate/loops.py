@@ -4,10 +4,9 @@ A source whose link hangs from two joints (an end effector fixed both to the arm
 world, a four-bar) is a closed loop, which a kit's tree cannot hold. Every format applies
 this rule:
 
-- `second_parents` (formats/urdf/repairs.py, on the URDF-shaped document every reader
-  builds, before the source model is read): the tree is built from the link's first joint
-  in document order; each later joint is taken out of the tree, one report line each, and
-  kept as a closure (`Source.closures`, source model joints once read);
+- `second_parents` (the translation's first step, on the source model): the tree is built
+  from the link's first joint in document order; each later joint is taken out of the
+  tree, one report line each, and kept as a closure (`Source.closures`);
 - `close` (a step after the names are made legal): each closure becomes a spec `loops`
   entry of type `weld` between the joint's parent and child links (a massless frame's
   holder link in its place), at the pose the tree puts the child in the parent's frame
@@ -24,12 +23,50 @@ is listed in `source_differences` under its key, closed or left out.
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 import numpy as np
 
+from simkit.importer.diagnostics import Report
 from simkit.importer.draft import Draft
+from simkit.importer.read.model import Joint
+from simkit.importer.read.source import Source
 from simkit.model.kinematics import forward, matrix_rpy
 from simkit.spec.names import MAX_NAME, name_problem
+
+
+def second_parents(source: Source, report: Report) -> None:
+    """Take each joint of the source model whose child link already hangs from an earlier
+    joint (document order) out of the tree (a closed loop), one report line each, and keep
+    it in `source.closures`; the first joint builds the tree."""
+    robot = source.robot
+    first: dict[str, Joint] = {}
+    tree: list[Joint] = []
+    for joint in robot.joints:
+        link = joint.child
+        if link is None or link not in first:  # no child: refused by tree(), naming it
+            if link is not None:
+                first[link] = joint
+            tree.append(joint)
+            continue
+        said = loop_reason(first[link], link)
+        kind = joint.type or "fixed"
+        if kind != "fixed":  # a four-bar's pin: the kit holds it rigid (no `connect` yet)
+            said += f"; its {kind} motion is locked (a weld holds all six degrees of freedom)"
+        report.changed(source, joint.at, said)
+        source.closures.append(joint)
+    if len(tree) != len(robot.joints):
+        source.robot = replace(robot, joints=tuple(tree))
+
+
+def loop_reason(first: Joint, link: str) -> str:
+    """The one line on a joint taken out of the tree because `link` hangs from `first`."""
+    return (
+        f"link '{link}' already has a parent joint '{first.name}' (line "
+        f"{first.at.sourceline or '?'}): a closed loop; the kit keeps the tree from the first "
+        "joint and closes the loop with a weld (spec `loops`) at the pose the tree gives "
+        "at home"
+    )
 
 
 def close(draft: Draft) -> None:

@@ -19,7 +19,6 @@ from pathlib import Path
 
 from simkit.importer.formats import provenance
 from simkit.importer.formats.sdf import kept, reader, tree
-from simkit.importer.formats.urdf import repairs
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -54,8 +53,6 @@ def read(shell: Source, options: ReadOptions) -> Source:
         why = f"joint '{world[0]}' mounts it on the world" if world else "the model is <static>"
         source.base = (False, f"fixed base: {why}; --floating-base frees it")
     source.kept = replace(source, root=copy.deepcopy(source.root))
-    if source.report is not None:
-        repairs.second_parents(source, source.report)
     return source
 
 

@@ -9,7 +9,7 @@ source check applies the same rule through Drake (the joint's frame on its child
 Joints: revolute (no finite limits: continuous), continuous, prismatic, fixed, ball ->
 `spherical` (three revolute joints, translate/ball_joints.py); a joint to `world` mounts the
 robot (a fixed base); a link's second parent joint (a closed loop) stays in the tree for the
-URDF repair to leave out (formats/urdf/repairs.py); a universal joint is two revolute joints
+translation to leave out (translate/loops.py); a universal joint is two revolute joints
 (universal.py). A `<frame>` is a kit frame: a massless
 leaf link on a fixed joint from the link it is attached to (the canonical link for the model
 frame, the world where a joint mounts the model). Revolute2, screw and gearbox

@@ -45,7 +45,7 @@ def emit(robot, model, ends: tuple, kit_frame: dict[str, str]) -> None:
 
     name, parent, child, joint = ends
     frame = kit_frame.get(child)
-    if frame != f"{name}#universal":  # a second parent (a loop): left out by the repair
+    if frame != f"{name}#universal":  # a second parent (a loop): left out by the translation
         frame = turned(model, name, joint)
     mid = f"{name}_link"
     parts = ((f"{name}_1", parent, mid, "1 0 0", "axis"), (name, mid, child, "0 1 0", "axis2"))

@@ -46,7 +46,6 @@ def repaired(source: Source) -> Source:
     source.kept = provenance.as_read(source)
     repairs.identical_duplicates(source, source.report)
     repairs.mounting_frame(source, source.report)
-    repairs.second_parents(source, source.report)
     return source
 
 

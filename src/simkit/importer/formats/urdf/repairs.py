@@ -14,8 +14,7 @@
   ankle): a closed loop, which a kit's tree cannot hold. The tree is built from the link's
   first joint in document order; each later one is closed by a weld (spec `loops`) and
   listed in `source_differences` (`joints.J`, formats/provenance.py): the shared rule of
-  importer/translate/loops.py, whose first half `second_parents` is (every format's reader
-  calls it).
+  importer/translate/loops.py, on the source model of every format.
 """
 
 from __future__ import annotations
@@ -82,35 +81,3 @@ def _same(a, b) -> bool:
     if (a.text or "").strip() != (b.text or "").strip() or len(a) != len(b):
         return False
     return all(_same(x, y) for x, y in zip(a, b, strict=True))
-
-
-def second_parents(source: Source, report: Report) -> None:
-    """Take each `<joint>` whose child link already has a parent joint earlier in the
-    document out of the tree (a closed loop), one report line each, and keep it in
-    `source.closures`; the first joint builds the tree."""
-    first: dict[str, object] = {}
-    for joint in source.root.findall("joint"):
-        child = joint.find("child")
-        link = None if child is None else child.get("link")
-        if link is None:
-            continue  # refused by tree(), naming the joint
-        if link not in first:
-            first[link] = joint
-            continue
-        said = loop_reason(first[link], link)
-        kind = joint.get("type") or "fixed"
-        if kind != "fixed":  # a four-bar's pin: the kit holds it rigid (no `connect` yet)
-            said += f"; its {kind} motion is locked (a weld holds all six degrees of freedom)"
-        report.changed(source, joint, said)
-        source.closures.append(joint)
-        source.root.remove(joint)
-
-
-def loop_reason(first, link: str) -> str:
-    """The one line on a joint taken out of the tree because `link` hangs from `first`."""
-    return (
-        f"link '{link}' already has a parent joint '{first.get('name')}' (line "
-        f"{first.sourceline or '?'}): a closed loop; the kit keeps the tree from the first "
-        "joint and closes the loop with a weld (spec `loops`) at the pose the tree gives "
-        "at home"
-    )

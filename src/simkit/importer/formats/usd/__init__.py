@@ -6,7 +6,8 @@ composes (issue 39).
   user names (`--variant`) or its default (stage.py), its one articulation found, then made
   the tree the shared translation takes (tree.py, mass.py, shapes.py; meshes written as STL
   into a scratch folder the import removes); the base floats unless a joint holds the root
-  body to the world; loop joints left out by the URDF repair `second_parents`;
+  body to the world; loop joints left out by the translation's `second_parents`
+  (translate/loops.py);
 - `keep`: every layer as read, byte for byte (kept.py), the variant read in `source.args`,
   and the differences: the shared ones (formats/provenance.py) and the listed ones;
 - `EDITS`: a drive force apart from the joint's own effort limit kept as the spec's
@@ -26,7 +27,6 @@ from pathlib import Path
 
 from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
-from simkit.importer.formats.urdf import repairs
 from simkit.importer.formats.usd import confine, kept, stage, tree
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
@@ -90,7 +90,6 @@ def read(shell: Source, options: ReadOptions) -> Source:
         else "fixed base: a joint holds the USD's root body to the world; --floating-base frees it",
     )
     source.kept = replace(source, root=copy.deepcopy(source.root))
-    repairs.second_parents(source, source.report)
     return source
 
 

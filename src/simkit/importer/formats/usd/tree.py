@@ -20,8 +20,8 @@ A joint with no body0 (or a body0 that is no rigid body) joins the robot to the 
 the root body a fixed one bolts the base (a `world` link), another moves it.
 Other joint types are read as fixed and listed; a drive's stiffness and damping are not read
 (the kit sizes its own servos). A joint with `excludeFromArticulation`, or one closing a
-loop (a body's second parent joint, in the stage's order), is emitted after the tree, so the URDF
-repair `second_parents` leaves it out (listed as dropped).
+loop (a body's second parent joint, in the stage's order), is emitted after the tree, so the
+translation's `second_parents` (translate/loops.py) leaves it out (listed as dropped).
 
 Mass: MassAPI `mass` (kg), `centerOfMass`, `diagonalInertia` and `principalAxes` in the body
 frame; where the mass is not authored, the collision shapes' solid at the MassAPI `density`
