@@ -1,6 +1,6 @@
 """Import every robot file of a corpus with `simkit import`'s default flags, no build.
 
-    python scripts/import_snapshot.py CORPUS_DIR OUT_DIR [--mjcf] [--movable-only]
+    python scripts/import_snapshot.py CORPUS_DIR OUT_DIR [--mjcf | --sdf] [--movable-only]
         [--only GLOB ...] [--exclude GLOB ...] [--timeout S]
 
 The files are chosen as scripts/import_corpus.py chooses them (same flags). Each import runs
@@ -76,10 +76,11 @@ def main() -> None:
     parser.add_argument("--only", action="append", default=[])
     parser.add_argument("--movable-only", action="store_true")
     parser.add_argument("--mjcf", action="store_true")
+    parser.add_argument("--sdf", action="store_true")
     parser.add_argument("--timeout", type=float, default=900.0, help="s per import")
     args = parser.parse_args()
     root = args.corpus.resolve()
-    found = urdfs(root, args.exclude, args.movable_only, args.only, args.mjcf)
+    found = urdfs(root, args.exclude, args.movable_only, args.only, args.mjcf, args.sdf)
     import simkit.cli  # noqa: F401  (imported once, before the forks)
 
     for i, path in enumerate(found, 1):
