@@ -2,8 +2,8 @@
 against Drake's SDFormat parser (libsdformat inside pydrake, a test-only dependency) on small
 files written for each construct: `relative_to` poses and `<frame>`s, a joint's default frame
 (its child link), `expressed_in` axes, nested and merged `<include>`s through `model://`; and
-the one-line refusals. The comparison is the source proof's (check/source/sdf/): the tree
-the reader gives is written as a URDF and read by Drake beside the SDF."""
+the one-line refusals. The comparison is the source proof's (check/source/sdf/): the source
+model the reader gives is written as a URDF and read by Drake beside the SDF."""
 
 from __future__ import annotations
 
@@ -54,9 +54,9 @@ def _findings(path: Path, tmp_path: Path, tamper=None) -> list:
 def test_frames_relative_to_and_default_joint_frame(tmp_path):
     """relative_to chains through a <frame>, a joint pose relative to its child link, an
     axis expressed in the model frame and one in the joint frame: Drake agrees."""
-    tree = _read(FILES / "frames.sdf").root
-    mount = tree.xpath("joint[child/@link='mount']")[0]  # a <frame>: a kit frame on its link
-    assert mount.get("type") == "fixed" and mount.find("parent").get("link") == "base"
+    robot = _read(FILES / "frames.sdf").robot
+    mount = next(j for j in robot.joints if j.child == "mount")  # a <frame>: a kit frame
+    assert mount.type == "fixed" and mount.parent == "base"
     found = _findings(FILES / "frames.sdf", tmp_path)
     assert [f.check for f in found] == ["source.joints", "source.links", "source.fk"]
     assert all(f.ok for f in found), found
@@ -73,7 +73,7 @@ def test_universal_joint_is_two_revolute_joints(tmp_path):
     """A universal joint: `u_1` about <axis>, `u` about <axis2>, the child's frame turned as
     Drake turns it; Drake agrees (FK at 100 configurations, masses)."""
     read = _read(FILES / "universal.sdf")
-    kinds = {j.get("name"): j.get("type") for j in read.root.iter("joint")}
+    kinds = {j.name: j.type for j in read.robot.joints}
     assert kinds == {"u_1": "revolute", "u": "revolute"}
     found = _findings(FILES / "universal.sdf", tmp_path)
     assert all(f.ok for f in found), found
@@ -106,10 +106,10 @@ def test_nested_and_merged_include_through_model_uri(tmp_path):
     """model://finger included twice: nested (`left::knuckle`) and merged (`knuckle`), a
     joint axis expressed in a nested link's frame: Drake agrees; the names are scoped."""
     path = FILES / "models" / "robot" / "model.sdf"
-    tree = _read(path).root
-    names = {link.get("name") for link in tree.iter("link")}
+    robot = _read(path).robot
+    names = {link.name for link in robot.links}
     assert names == {"palm", "left::knuckle", "left::pad", "knuckle", "pad", "left::tip", "tip"}
-    frames = {j.find("child").get("link"): j.find("parent").get("link") for j in tree.iter("joint")}
+    frames = {j.child: j.parent for j in robot.joints}
     assert frames["tip"] == "knuckle" and frames["left::tip"] == "left::knuckle"  # model frame
     found = _findings(path, tmp_path)
     assert all(f.ok for f in found), found

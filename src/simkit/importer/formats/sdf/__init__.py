@@ -1,24 +1,26 @@
 """SDFormat: a `.sdf` file (root element `<sdf>`) or a Gazebo model folder (`model.config`).
 
 - `read`: the file confined and bounded, its includes expanded and its one model found
-  (reader.py, files.py), then made the tree the shared translation takes by simkit's own
-  reader of SDFormat's frame semantics (frames.py, tree.py; tested against Drake's parser),
-  the base fixed where a joint mounts the model on the world or it is `<static>`, the tree
-  kept as read; a second parent joint (a closed loop) is left out as for a URDF;
+  (reader.py, files.py), then made the source model the shared translation takes
+  (`source.robot`, read/model.py) by simkit's own reader of SDFormat's frame semantics
+  (frames.py, tree.py; tested against Drake's parser), the base fixed where a joint mounts
+  the model on the world or it is `<static>`; a second parent joint (a closed loop) is left
+  out as for a URDF;
 - `keep`: the model file byte for byte and every file it read (kept.py), and the shared
-  differences (formats/provenance.py);
+  differences (formats/provenance.py, which reads the model as read written as a URDF
+  document, formats/urdf/document.py);
 - no `EDITS` or `AFTER` of its own.
 """
 
 from __future__ import annotations
 
-import copy
 import re
 from dataclasses import replace
 from pathlib import Path
 
 from simkit.importer.formats import provenance
 from simkit.importer.formats.sdf import kept, reader, tree
+from simkit.importer.formats.urdf.document import document
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -46,13 +48,13 @@ def title(head: bytes) -> str | None:
 
 
 def read(shell: Source, options: ReadOptions) -> Source:
-    """The model read and made a tree; the base a world joint or `<static>` fixes."""
+    """The model read and made the source model; the base a world joint or `<static>` fixes."""
     source = reader.read(shell, options)
-    source.root, world = tree.to_tree(source)
+    source.robot, world = tree.to_robot(source)
     if world or source.static:
         why = f"joint '{world[0]}' mounts it on the world" if world else "the model is <static>"
         source.base = (False, f"fixed base: {why}; --floating-base frees it")
-    source.kept = replace(source, root=copy.deepcopy(source.root))
+    source.kept = replace(source, root=document(source.robot))
     return source
 
 

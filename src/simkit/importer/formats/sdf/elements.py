@@ -1,21 +1,24 @@
-"""The URDF-shaped elements written for an SDF model's joints and frames (tree.py and
-universal.py share them): a frame's pose in the model frame, an `<origin>`, an axis in its
-joint frame (`expressed_in`), and `<limit>`/`<dynamics>`. Numbers are written exactly
-(`repr`), so the shared translation reads back the reader's values."""
+"""The source-model pieces an SDF model's joints and frames share (tree.py, universal.py): a
+frame's pose in the model frame, an origin `Pose`, an axis in its joint frame
+(`expressed_in`), a joint's `Limit` and `Dynamics`, all numbers plain floats as the reader
+computed them; and the refusal of a computed number that is not finite (`finite`)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
 from simkit.importer.formats.sdf.frames import MODEL, WORLD, inverse, numbers, rpy_of, scoped
+from simkit.importer.read.model import At, Dynamics, Limit, Pose, Robot
 
 #: |limit| at or above which an SDF limit means none (the specification's default is 1e16)
 NO_LIMIT = 1e15
 
 
-def fmt(values) -> str:
-    """Numbers as a URDF attribute: exact (repr), space-separated."""
-    return " ".join(repr(float(v)) for v in np.ravel(values))
+def vec(values) -> tuple[float, ...]:
+    """Numbers as a tuple of plain floats (the model is typed: no numpy scalars)."""
+    return tuple(float(v) for v in np.ravel(values))
 
 
 def in_model(model, name: str, element) -> np.ndarray:
@@ -25,10 +28,9 @@ def in_model(model, name: str, element) -> np.ndarray:
     return model.frames.in_model(name, element)
 
 
-def origin(parent, x: np.ndarray) -> None:
-    from lxml import etree
-
-    etree.SubElement(parent, "origin", xyz=fmt(x[:3, 3]), rpy=fmt(rpy_of(x[:3, :3])))
+def origin(x: np.ndarray, line: int | None) -> Pose:
+    """The `Pose` of a 4x4 transform (m; URDF roll-pitch-yaw, rad), placed on `line`."""
+    return Pose(vec(x[:3, 3]), vec(rpy_of(x[:3, :3])), At("origin", None, line))  # type: ignore[arg-type]
 
 
 def axis_in_joint(model, joint, tag: str, x_joint: np.ndarray) -> np.ndarray:
@@ -51,9 +53,9 @@ def axis_in_joint(model, joint, tag: str, x_joint: np.ndarray) -> np.ndarray:
     return vector / np.linalg.norm(vector)
 
 
-def limits(out, src, axis, kind: str) -> None:
-    from lxml import etree
-
+def limits(src, axis, kind: str, line: int | None) -> tuple[str, Limit | None, Dynamics | None]:
+    """The joint's type (a revolute joint without finite limits is continuous), its limits
+    (None: none given; a continuous joint keeps no position limits) and its dynamics."""
     limit = axis.find("limit")
 
     def value(tag: str) -> float | None:
@@ -63,20 +65,48 @@ def limits(out, src, axis, kind: str) -> None:
     lower, upper, effort, velocity = (value(t) for t in ("lower", "upper", "effort", "velocity"))
     bounded = lower is not None and upper is not None and max(abs(lower), abs(upper)) < NO_LIMIT
     if kind == "revolute" and not bounded:
-        out.set("type", "continuous")
-    attrs = {"lower": fmt([lower]), "upper": fmt([upper])} if bounded else {}
+        kind = "continuous"
+    given = {"lower": lower, "upper": upper} if bounded else {}
     if effort is not None and effort > 0:
-        attrs["effort"] = fmt([effort])
+        given["effort"] = effort
     if velocity is not None and velocity > 0:
-        attrs["velocity"] = fmt([velocity])
-    if attrs:
-        etree.SubElement(out, "limit", **attrs)
+        given["velocity"] = velocity
+    if kind == "continuous":
+        given.update((k, None) for k in ("lower", "upper") if k in given)
+    out = Limit(At("limit", None, line), **given) if given else None
     damping = axis.findtext("dynamics/damping")
     friction = axis.findtext("dynamics/friction")
-    if damping or friction:
-        etree.SubElement(
-            out,
-            "dynamics",
-            damping=fmt([float(damping or 0)]),
-            friction=fmt([float(friction or 0)]),
-        )
+    if not (damping or friction):
+        return kind, out, None
+    return (
+        kind,
+        out,
+        Dynamics(At("dynamics", None, line), float(damping or 0), float(friction or 0)),
+    )
+
+
+def finite(source, robot: Robot) -> Robot:
+    """The model, its computed numbers (poses, axes, damping) refused where one is not
+    finite, in one line at the node, in the order formats/urdf/model.py reads a document."""
+
+    def check(at, attr: str, values) -> None:
+        values = values if isinstance(values, tuple) else (values,)
+        if not all(math.isfinite(v) for v in values):
+            text = " ".join(repr(v) for v in values)
+            raise source.fail(at, f"'{attr}' needs {len(values)} finite numbers, got '{text}'")
+
+    def pose(p: Pose) -> None:
+        check(p.at, "xyz", p.xyz)
+        check(p.at, "rpy", p.rpy)
+
+    for link in robot.links:
+        for placed in ((link.inertial,) if link.inertial else ()) + link.visuals + link.collisions:
+            pose(placed.origin)
+    for joint in robot.joints:
+        pose(joint.origin)
+        if joint.axis is not None:
+            check(joint.axis_at, "xyz", joint.axis)
+        if joint.dynamics is not None:
+            check(joint.dynamics.at, "damping", joint.dynamics.damping)
+            check(joint.dynamics.at, "friction", joint.dynamics.friction)
+    return robot

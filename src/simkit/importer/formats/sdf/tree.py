@@ -1,4 +1,5 @@
-"""A read SDFormat model (reader.py) to the URDF-shaped tree the shared translation takes.
+"""A read SDFormat model (reader.py) to the source model the shared translation takes
+(read/model.py `Robot`: links and joints in URDF terms, numbers as the floats computed here).
 
 Frames follow the specification (frames.py). A URDF joint turns about its child link's
 origin; an SDF joint has its own frame (by default its child link's, moved by its `<pose>`).
@@ -24,10 +25,11 @@ import numpy as np
 from simkit.importer.formats.sdf import universal
 from simkit.importer.formats.sdf.elements import (
     axis_in_joint,
-    fmt,
+    finite,
     in_model,
     limits,
     origin,
+    vec,
 )
 from simkit.importer.formats.sdf.frames import (
     MODEL,
@@ -38,6 +40,7 @@ from simkit.importer.formats.sdf.frames import (
     pose_of,
     scoped,
 )
+from simkit.importer.read.model import At, Geometry, Inertial, Joint, Link, Material, Robot, Shape
 
 #: SDF joint type -> URDF type; the others are refused
 KINDS = {
@@ -122,15 +125,13 @@ class Model:
         return found
 
 
-def to_tree(source) -> tuple[object, list[str]]:
-    """The `<robot>` tree of the model, and the joints mounting it on the world."""
-    from lxml import etree
-
+def to_robot(source) -> tuple[Robot, list[str]]:
+    """The source model of the model, and the joints mounting it on the world. Each node is
+    on its SDF element's line (the model's where the element has none)."""
     model = Model(source)
     if not model.links:
         raise source.fail(source.model, "the model has no link")
-    robot = etree.Element("robot", name=source.model.get("name") or "robot")
-    robot.sourceline = source.model.sourceline
+    line = source.model.sourceline
     kit_frame: dict[str, str] = {}
     ends: list[tuple[str, str, str, object]] = []
     for name, joint in model.joints.items():
@@ -150,41 +151,41 @@ def to_tree(source) -> tuple[object, list[str]]:
             + ", not one robot; import one per file",
         )
     world = [n for n, p, _, _ in ends if p == WORLD]
-    if world:
-        link = etree.SubElement(robot, "link", name=WORLD)
-        link.sourceline = model.joints[world[0]].sourceline
+    links: list[Link] = []
+    if world:  # the world a joint mounts the model on: a link of the tree
+        links.append(Link(WORLD, At("link", WORLD, model.joints[world[0]].sourceline or line)))
     for name, element in model.links.items():
-        _link(robot, model, name, element, kit_frame.get(name, name))
+        links.append(_link(model, name, element, kit_frame.get(name, name), line))
+    joints: list[Joint] = []
     for name, parent, child, joint in ends:
         if joint.get("type") == "universal":
-            universal.emit(robot, model, (name, parent, child, joint), kit_frame)
+            two, mid = universal.emit(model, (name, parent, child, joint), kit_frame, line)
+            joints += two
+            links.append(mid)
         else:
-            _joint(robot, model, name, joint, parent, child, kit_frame)
-    _frames(robot, model, kit_frame, WORLD if world else model.canonical)
-    for element in robot.iter():  # report lines: an element without one takes its parent's
-        if not element.sourceline and element.getparent() is not None:
-            element.sourceline = element.getparent().sourceline
-    return robot, world
+            joints.append(_joint(model, name, joint, (parent, child), kit_frame, line))
+    _frames(links, joints, model, kit_frame, WORLD if world else model.canonical, line)
+    materials = tuple(g.material for link in links for g in link.visuals if g.material)
+    title = source.model.get("name") or "robot"
+    robot = Robot(At("robot", title, line), title, tuple(links), tuple(joints), materials)
+    return finite(source, robot), world
 
 
-def _frames(robot, model: Model, kit_frame: dict[str, str], on_model: str) -> None:
+def _frames(links: list, joints: list, model: Model, kit_frame: dict[str, str], on_model: str,
+            line: int | None) -> None:  # fmt: skip
     """Each `<frame>`: a kit frame, a massless leaf link on a fixed joint from the link it
     is attached to (one attached to the model frame: the world where a joint mounts the
     model on it, else the canonical link, which carries the model frame)."""
-    from lxml import etree
-
     taken = set(model.links) | set(model.joints) | set(model.named)
     for name, element in model.named.items():
         link = model.link_of(name, element)
         link = on_model if link == MODEL else link
         joint = _free(f"{name}_joint", taken)
-        out = etree.SubElement(robot, "joint", name=joint, type="fixed")
-        out.sourceline = element.sourceline
+        here = element.sourceline or line
         parent = in_model(model, kit_frame.get(link, link), element)
-        origin(out, inverse(parent) @ model.frames.in_model(name, element))
-        etree.SubElement(out, "parent", link=link)
-        etree.SubElement(out, "child", link=name)
-        etree.SubElement(robot, "link", name=name).sourceline = element.sourceline
+        pose = origin(inverse(parent) @ model.frames.in_model(name, element), here)
+        joints.append(Joint(joint, "fixed", At("joint", joint, here), link, name, pose))
+        links.append(Link(name, At("link", name, here)))
 
 
 def _free(name: str, taken: set[str]) -> str:
@@ -208,27 +209,24 @@ def _placed(model: Model, element, link: str, kit: np.ndarray) -> np.ndarray:
     return inverse(kit) @ base @ pose_of(model.source, pose)
 
 
-def _link(robot, model: Model, name: str, element, frame: str) -> None:
-    from lxml import etree
-
-    link = etree.SubElement(robot, "link", name=name)
-    link.sourceline = element.sourceline
+def _link(model: Model, name: str, element, frame: str, line: int | None) -> Link:
+    """A link: its inertial (1 kg, unit inertia where the SDF gives none, as SDFormat's
+    defaults), visuals and collisions, in its kit frame `frame`."""
+    line = element.sourceline or line
     kit = model.frames.in_model(frame, element)
     inertial = element.find("inertial")
     if inertial is not None and inertial.get("auto") in ("true", "1"):
         raise model.source.fail(inertial, "automatic inertia (<inertial auto>): not read")
-    out = etree.SubElement(link, "inertial")
-    origin(
-        out,
+    pose = origin(
         _placed(model, inertial, name, kit)
         if inertial is not None
         else inverse(kit) @ model.frames.in_model(name),
+        line,
     )
     mass = 1.0 if inertial is None or inertial.find("mass") is None else numbers(
         model.source, inertial.find("mass"), inertial.findtext("mass"), 1)[0]  # fmt: skip
-    etree.SubElement(out, "mass", value=fmt([mass]))
     moments = inertial.find("inertia") if inertial is not None else None
-    terms = {}
+    terms = []
     for key, default in (
         ("ixx", 1.0),
         ("iyy", 1.0),
@@ -238,19 +236,32 @@ def _link(robot, model: Model, name: str, element, frame: str) -> None:
         ("iyz", 0.0),
     ):
         found = None if moments is None else moments.find(key)
-        terms[key] = fmt(
-            [default if found is None else numbers(model.source, found, found.text, 1)[0]]
+        terms.append(default if found is None else numbers(model.source, found, found.text, 1)[0])
+    at = At("inertial", None, line)
+    inertia = tuple(terms) if mass > 0 else None  # a massless link's inertia is not read
+    mass_at, inertia_at = At("mass", None, line), At("inertia", None, line)
+    drawn = {
+        tag: tuple(
+            g
+            for k, shape in enumerate(element.findall(tag))
+            if (g := _shape(model, name, shape, (tag, k), kit, line)) is not None
         )
-    etree.SubElement(out, "inertia", **terms)
-    for tag in ("visual", "collision"):
-        for k, shape in enumerate(element.findall(tag)):
-            _shape(link, model, name, shape, tag, k, kit)
+        for tag in ("visual", "collision")
+    }
+    return Link(
+        name,
+        At("link", name, line),
+        Inertial(at, pose, float(mass), mass_at, inertia, inertia_at),  # type: ignore[arg-type]
+        drawn["visual"],
+        drawn["collision"],
+    )
 
 
-def _shape(link, model: Model, name: str, shape, tag: str, k: int, kit: np.ndarray) -> None:
-    """One visual or collision; shapes a URDF cannot hold are reported as dropped."""
-    from lxml import etree
-
+def _shape(model: Model, name: str, shape, which: tuple[str, int], kit: np.ndarray,
+           line: int | None) -> Geometry | None:  # fmt: skip
+    """One visual or collision (`which`: its tag and index); shapes a URDF cannot hold are
+    reported as dropped (None)."""
+    tag, k = which
     geometry = shape.find("geometry")
     kind = (
         next((g for g in geometry if isinstance(g.tag, str)), None)
@@ -260,13 +271,9 @@ def _shape(link, model: Model, name: str, shape, tag: str, k: int, kit: np.ndarr
     if kind is None or kind.tag not in ("box", "sphere", "cylinder", "capsule", "mesh"):
         if model.source.report is not None and kind is not None and kind.tag != "empty":
             model.source.report.dropped(model.source, shape, f"<{kind.tag}> geometry: no URDF form")
-        return
-    out = etree.SubElement(link, tag)
-    if shape.get("name"):
-        out.set("name", shape.get("name"))
-    out.sourceline = shape.sourceline
-    origin(out, _placed(model, shape, name, kit))
-    geo = etree.SubElement(out, "geometry")
+        return None
+    line = shape.sourceline or line
+    pose = origin(_placed(model, shape, name, kit), line)
     src = model.source
 
     def num(field: str, count: int = 1, default=None) -> list[float]:
@@ -278,39 +285,42 @@ def _shape(link, model: Model, name: str, shape, tag: str, k: int, kit: np.ndarr
         return numbers(src, element, element.text, count)
 
     if kind.tag == "box":
-        etree.SubElement(geo, "box", size=fmt(num("size", 3)))
+        sizes: dict = {"size": vec(num("size", 3))}
     elif kind.tag == "sphere":
-        etree.SubElement(geo, "sphere", radius=fmt(num("radius")))
+        sizes = {"radius": num("radius")[0]}
     elif kind.tag in ("cylinder", "capsule"):
-        etree.SubElement(geo, kind.tag, radius=fmt(num("radius")), length=fmt(num("length")))
+        sizes = {"radius": num("radius")[0], "length": num("length")[0]}
     else:
-        mesh = etree.SubElement(geo, "mesh", filename=(kind.findtext("uri") or "").strip())
-        mesh.set("scale", fmt(num("scale", 3, [1.0, 1.0, 1.0])))
+        sizes = {"filename": (kind.findtext("uri") or "").strip()}
+        sizes["scale"] = vec(num("scale", 3, [1.0, 1.0, 1.0]))
+    drawn = Shape(kind.tag, At(kind.tag, None, line), **sizes)
     diffuse = shape.find("material/diffuse") if tag == "visual" else None
+    material = None
     if diffuse is not None:
         rgba = numbers(src, diffuse, diffuse.text)
         rgba = (rgba + [1.0] * 4)[:4] if len(rgba) >= 3 else [0.7, 0.7, 0.7, 1.0]
-        material = etree.SubElement(out, "material", name=f"sdf_{name}_{tag}{k}")
-        etree.SubElement(material, "color", rgba=fmt(rgba))
+        called = f"sdf_{name}_{tag}{k}"
+        material = Material(At("material", called, line), called, vec(rgba))  # type: ignore[arg-type]
+    return Geometry(At(tag, shape.get("name") or None, line), pose, drawn, material)
 
 
-def _joint(robot, model: Model, name: str, joint, parent: str, child: str, kit_frame) -> None:
-    from lxml import etree
-
+def _joint(model: Model, name: str, joint, link_ends: tuple[str, str], kit_frame,
+           line: int | None) -> Joint:  # fmt: skip
+    """A joint between `link_ends` (parent, child), its origin in the parent's kit frame."""
     src = model.source
     kind = (joint.get("type") or "").strip()
     if kind not in KINDS:
         raise src.fail(
             joint, f"a {kind or 'typeless'} joint: a kit's joints turn about one axis each"
         )
-    out = etree.SubElement(robot, "joint", name=name, type=KINDS[kind])
-    out.sourceline = joint.sourceline
+    line = joint.sourceline or line
+    parent, child = link_ends
     x_joint = model.frames.in_model(name, joint)
     parent_frame = kit_frame.get(parent, parent)
-    origin(out, inverse(in_model(model, parent_frame, joint)) @ x_joint)
-    etree.SubElement(out, "parent", link=parent)
-    etree.SubElement(out, "child", link=child)
+    pose = origin(inverse(in_model(model, parent_frame, joint)) @ x_joint, line)
+    at = At("joint", name, line)
     if kind in ("fixed", "ball"):
-        return
-    etree.SubElement(out, "axis", xyz=fmt(axis_in_joint(model, joint, "axis", x_joint)))
-    limits(out, src, joint.find("axis"), kind)
+        return Joint(name, KINDS[kind], at, parent, child, pose)
+    axis = vec(axis_in_joint(model, joint, "axis", x_joint))
+    kind, limit, dynamics = limits(src, joint.find("axis"), kind, line)
+    return Joint(name, kind, at, parent, child, pose, axis, At("axis", None, line), limit, dynamics)  # type: ignore[arg-type]

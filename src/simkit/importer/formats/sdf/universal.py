@@ -15,6 +15,7 @@ import numpy as np
 
 from simkit.importer.formats.sdf.elements import axis_in_joint, in_model, limits, origin
 from simkit.importer.formats.sdf.frames import inverse, transform
+from simkit.importer.read.model import At, Joint, Link
 
 #: |cos| between the two axes above which they are not perpendicular
 PERPENDICULAR = 1e-6
@@ -39,28 +40,28 @@ def turned(model, name: str, joint) -> str:
     return frame
 
 
-def emit(robot, model, ends: tuple, kit_frame: dict[str, str]) -> None:
-    """The two revolute joints and the link between them, into `robot`."""
-    from lxml import etree
-
+def emit(model, ends: tuple, kit_frame: dict[str, str], line: int | None) -> tuple:
+    """The two revolute joints and the link between them (`Joint`s, `Link`); `line`: the
+    model's, where the joint has none."""
     name, parent, child, joint = ends
+    line = joint.sourceline or line
     frame = kit_frame.get(child)
     if frame != f"{name}#universal":  # a second parent (a loop): left out by the translation
         frame = turned(model, name, joint)
     mid = f"{name}_link"
-    parts = ((f"{name}_1", parent, mid, "1 0 0", "axis"), (name, mid, child, "0 1 0", "axis2"))
+    parts = ((f"{name}_1", parent, mid, (1.0, 0.0, 0.0), "axis"),
+             (name, mid, child, (0.0, 1.0, 0.0), "axis2"))  # fmt: skip
+    joints = []
     for k, (joint_name, up, down, xyz, tag) in enumerate(parts):
-        out = etree.SubElement(robot, "joint", name=joint_name, type="revolute")
-        out.sourceline = joint.sourceline
         if k == 0:
             parent_pose = in_model(model, kit_frame.get(up, up), joint)
-            origin(out, inverse(parent_pose) @ model.frames.in_model(frame, joint))
+            pose = origin(inverse(parent_pose) @ model.frames.in_model(frame, joint), line)
         else:
-            origin(out, np.eye(4))
-        etree.SubElement(out, "parent", link=up)
-        etree.SubElement(out, "child", link=down)
-        etree.SubElement(out, "axis", xyz=xyz)
-        limits(out, model.source, joint.find(tag), "revolute")
-    etree.SubElement(robot, "link", name=mid).sourceline = joint.sourceline
+            pose = origin(np.eye(4), line)
+        kind, limit, dynamics = limits(model.source, joint.find(tag), "revolute", line)
+        at = At("joint", joint_name, line)
+        joints.append(Joint(joint_name, kind, at, up, down, pose, xyz, At("axis", None, line),
+                            limit, dynamics))  # fmt: skip
     why = "added: the link between a universal joint's two axes"
     model.source.listed += [(f"links.{mid}", why), (f"joints.{name}_1", why)]
+    return joints, Link(mid, At("link", mid, line))

@@ -78,7 +78,7 @@ def _link(element, link: Link) -> None:
         _inertial(_child(element, "inertial", link.inertial.at), link.inertial)
     for tag, geometries in (("visual", link.visuals), ("collision", link.collisions)):
         for geometry in geometries:
-            _geometry(_child(element, tag, geometry.at), geometry)
+            _geometry(_child(element, tag, geometry.at, name=geometry.at.name), geometry)
     _unread(element, link.unknown)
 
 

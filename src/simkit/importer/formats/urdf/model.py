@@ -9,7 +9,7 @@ dynamics and mimic of a joint that does not move, a fixed or continuous joint's 
 limits, a spherical joint's axis (PyBullet ignores it). A `<mass>` that is no number
 reads as massless (as urdfdom's bodies without mass).
 
-The other formats (MJCF, SDFormat, USD) build a URDF-shaped document from their own model
+The MJCF and USD readers build a URDF-shaped document from their own model (SDFormat: none)
 and read it here, so the translation has one model to read.
 """
 
