@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import copy
 import re
 import shutil
 import tempfile
@@ -24,6 +23,7 @@ from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
 from simkit.importer.formats.mjcf import excludes, kept, reader, tree
 from simkit.importer.formats.mjcf.reader import MjcfSource
+from simkit.importer.formats.urdf.document import document
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
@@ -51,7 +51,7 @@ def read(shell: Source, options: ReadOptions) -> MjcfSource:
     scratch = Path(tempfile.mkdtemp(prefix="simkit-mjcf-"))
     source.scratch.append(scratch)
     try:
-        source.root, floating, source.listed = tree.to_tree(source, scratch)
+        source.robot, floating, source.listed = tree.to_robot(source, scratch)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
@@ -62,7 +62,7 @@ def read(shell: Source, options: ReadOptions) -> MjcfSource:
         if floating
         else "fixed base: the MJCF's root body has no free joint; --floating-base frees it",
     )
-    source.kept = replace(source, root=copy.deepcopy(source.root))
+    source.kept = replace(source, root=document(source.robot))  # provenance reads it
     return source
 
 
