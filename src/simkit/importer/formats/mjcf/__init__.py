@@ -1,9 +1,11 @@
 """MJCF: a MuJoCo model file (root element `<mujoco>`), read by MuJoCo itself (issue 31).
 
 - `read`: the file confined and bounded, compiled by MuJoCo (reader.py), then its robot
-  made the tree the shared translation takes (tree.py; meshes written as STL into a scratch
-  folder the import removes), the elements a kit cannot carry listed (listed.py), the base
-  floating where the root body has a free joint (`Source.base`), the tree kept as read;
+  made the source model the shared translation takes (`Source.robot`, tree.py; meshes
+  written as STL into a scratch folder the import removes), its body welds closure joints
+  (welds.py), the elements a kit cannot carry listed (listed.py), the base floating where
+  the root body has a free joint (`Source.base`), and the model kept as a URDF document
+  (`kept.root`, formats/urdf/document.py) for the source differences (provenance.py);
 - `keep`: the model file byte for byte and every file it read (kept.py), and the
   differences: the shared ones (formats/provenance.py) and the listed ones;
 - `EDITS`: the model's contact excludes carried into the spec (excludes.py);
@@ -45,8 +47,8 @@ def title(head: bytes) -> str | None:
 
 
 def read(shell: Source, options: ReadOptions) -> MjcfSource:
-    """The model compiled by MuJoCo and its robot's tree, the base its free joint says,
-    the tree as read kept for the source differences."""
+    """The model compiled by MuJoCo and its robot's source model, the base its free joint
+    says, the model written as a URDF document kept for the source differences."""
     source = reader.read(shell, options)
     scratch = Path(tempfile.mkdtemp(prefix="simkit-mjcf-"))
     source.scratch.append(scratch)

@@ -1,12 +1,14 @@
-"""A compiled MJCF (formats/mjcf/reader.py) to the URDF-shaped tree the shared translation takes.
+"""A compiled MJCF (formats/mjcf/reader.py) to the source model (read/model.py) the shared
+translation takes, numbers as floats straight from MuJoCo's arrays (no text between).
 
 MuJoCo has compiled the model, so every number here is the simulator's: bodies are links
 (inertial from the compiled model: mass, CoM, principal inertia and its axes), hinge ->
 revolute (no range: continuous), slide -> prismatic, ball -> a `spherical` joint (three
-revolute ones, ball_joints.py), a free root -> the floating base, sites -> frames (massless
-leaves on fixed joints), joint actuators -> the joint's effort, geoms -> visuals
-(contype = conaffinity = 0) or collisions, meshes as MuJoCo compiled them (scaled, recentred)
-written as STL. The shared translation (convert.py) then makes the spec exactly as for a URDF.
+revolute ones, translate/ball_joints.py), a free root -> the floating base, sites -> frames
+(massless leaves on fixed joints), joint actuators -> the joint's effort, geoms -> visuals
+(contype = conaffinity = 0) or collisions, meshes as MuJoCo compiled them (scaled,
+recentred) written as STL. The shared translation (translate/convert.py) then makes the
+spec exactly as for a URDF. Each node's `At` names the MJCF line it comes from (`Place`).
 
 Frames: a URDF joint turns about its child link's origin, an MJCF joint about its own `pos`
 in the body. A body's link frame is therefore its body frame moved by `offset` (the last
