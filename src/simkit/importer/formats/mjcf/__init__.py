@@ -1,9 +1,11 @@
 """MJCF: a MuJoCo model file (root element `<mujoco>`), read by MuJoCo itself (issue 31).
 
 - `read`: the file confined and bounded, compiled by MuJoCo (reader.py), then its robot
-  made the tree the shared translation takes (tree.py; meshes written as STL into a scratch
-  folder the import removes), the elements a kit cannot carry listed (listed.py), the base
-  floating where the root body has a free joint (`Source.base`), the tree kept as read;
+  made the source model the shared translation takes (`Source.robot`, tree.py; meshes
+  written as STL into a scratch folder the import removes), its body welds closure joints
+  (welds.py), the elements a kit cannot carry listed (listed.py), the base floating where
+  the root body has a free joint (`Source.base`), and the model kept as a URDF document
+  (`kept.root`, formats/urdf/document.py) for the source differences (provenance.py);
 - `keep`: the model file byte for byte and every file it read (kept.py), and the
   differences: the shared ones (formats/provenance.py) and the listed ones;
 - `EDITS`: the model's contact excludes carried into the spec (excludes.py);
@@ -13,7 +15,6 @@
 
 from __future__ import annotations
 
-import copy
 import re
 import shutil
 import tempfile
@@ -24,6 +25,7 @@ from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
 from simkit.importer.formats.mjcf import excludes, kept, reader, tree
 from simkit.importer.formats.mjcf.reader import MjcfSource
+from simkit.importer.formats.urdf.document import document
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
@@ -45,13 +47,13 @@ def title(head: bytes) -> str | None:
 
 
 def read(shell: Source, options: ReadOptions) -> MjcfSource:
-    """The model compiled by MuJoCo and its robot's tree, the base its free joint says,
-    the tree as read kept for the source differences."""
+    """The model compiled by MuJoCo and its robot's source model, the base its free joint
+    says, the model written as a URDF document kept for the source differences."""
     source = reader.read(shell, options)
     scratch = Path(tempfile.mkdtemp(prefix="simkit-mjcf-"))
     source.scratch.append(scratch)
     try:
-        source.root, floating, source.listed = tree.to_tree(source, scratch)
+        source.robot, floating, source.listed = tree.to_robot(source, scratch)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
@@ -62,7 +64,7 @@ def read(shell: Source, options: ReadOptions) -> MjcfSource:
         if floating
         else "fixed base: the MJCF's root body has no free joint; --floating-base frees it",
     )
-    source.kept = replace(source, root=copy.deepcopy(source.root))
+    source.kept = replace(source, root=document(source.robot))  # provenance reads it
     return source
 
 

@@ -41,8 +41,8 @@ DIR_ATTRS = ("meshdir", "texturedir", "assetdir")
 @dataclass
 class MjcfSource(Source):
     """A read MJCF: the compiled `model` (mujoco.MjModel) and its `spec` (mujoco.MjSpec);
-    `files`: every file it read, relative to the model's folder -> bytes. `root` is filled
-    by tree.py with the URDF-shaped tree the shared translation takes."""
+    `files`: every file it read, relative to the model's folder -> bytes. `robot` is set
+    by tree.py: the source model (read/model.py) the shared translation takes."""
 
     model: object = None
     spec: object = None

@@ -1,12 +1,14 @@
-"""A compiled MJCF (formats/mjcf/reader.py) to the URDF-shaped tree the shared translation takes.
+"""A compiled MJCF (formats/mjcf/reader.py) to the source model (read/model.py) the shared
+translation takes, numbers as floats straight from MuJoCo's arrays (no text between).
 
 MuJoCo has compiled the model, so every number here is the simulator's: bodies are links
 (inertial from the compiled model: mass, CoM, principal inertia and its axes), hinge ->
 revolute (no range: continuous), slide -> prismatic, ball -> a `spherical` joint (three
-revolute ones, ball_joints.py), a free root -> the floating base, sites -> frames (massless
-leaves on fixed joints), joint actuators -> the joint's effort, geoms -> visuals
-(contype = conaffinity = 0) or collisions, meshes as MuJoCo compiled them (scaled, recentred)
-written as STL. The shared translation (convert.py) then makes the spec exactly as for a URDF.
+revolute ones, translate/ball_joints.py), a free root -> the floating base, sites -> frames
+(massless leaves on fixed joints), joint actuators -> the joint's effort, geoms -> visuals
+(contype = conaffinity = 0) or collisions, meshes as MuJoCo compiled them (scaled,
+recentred) written as STL. The shared translation (translate/convert.py) then makes the
+spec exactly as for a URDF. Each node's `At` names the MJCF line it comes from (`Place`).
 
 Frames: a URDF joint turns about its child link's origin, an MJCF joint about its own `pos`
 in the body. A body's link frame is therefore its body frame moved by `offset` (the last
@@ -18,6 +20,7 @@ massless links `JOINT_link`. What a kit cannot carry is listed (listed.py).
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,15 +29,23 @@ from simkit.errors import SpecError
 from simkit.importer.formats.mjcf import listed as mjcf_listed
 from simkit.importer.formats.mjcf import welds
 from simkit.importer.formats.mjcf.reader import MjcfSource
+from simkit.importer.read.model import (
+    At,
+    Dynamics,
+    Geometry,
+    Inertial,
+    Joint,
+    Limit,
+    Link,
+    Material,
+    Pose,
+    Robot,
+    Shape,
+)
 
 #: mjtJoint: free, ball, slide, hinge; mjtGeom
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 PLANE, HFIELD, SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = range(8)
-
-
-def fmt(values) -> str:
-    """Numbers as the shortest text that reads back exactly."""
-    return " ".join(repr(float(v)) for v in np.ravel(values))
 
 
 def rpy(mat: np.ndarray) -> np.ndarray:
@@ -98,62 +109,64 @@ def robot_root(model, path: Path, lines: dict | None = None) -> int:
     return next(iter(tops))
 
 
-def to_tree(source: MjcfSource, scratch: Path) -> tuple[object, bool, list[tuple[str, str]]]:
-    """The URDF-shaped `<robot>` of the compiled model, meshes written as STL into
-    `scratch`; returns (root element, floating, listed differences)."""
-    from lxml import etree
-
+def to_robot(source: MjcfSource, scratch: Path) -> tuple[Robot, bool, list[tuple[str, str]]]:
+    """The source model of the compiled model's robot, meshes written as STL into
+    `scratch`, its body welds in `source.closures`; returns (robot, floating, listed
+    differences)."""
     model = source.model
     root_body = robot_root(model, source.path, source.lines)
     off = offsets(model)
     names = Names(model)
-    robot = etree.Element("robot", name=model.names[: model.names.find(b"\0")].decode() or "robot")
+    top = Place(source.lines.get(("body", root_body)) or None)
     bodies = [b for b in range(1, model.nbody) if model.body_rootid[b] == root_body]
     listed = mjcf_listed.collect(model, root_body, bodies)
-    added: list[str] = []
     first = int(model.body_jntadr[root_body])
     floating = model.body_jntnum[root_body] > 0 and model.jnt_type[first] == FREE
     moves = model.body_jntnum[root_body] > 0 and not floating  # jointed to the world
+    build = Build(source, model, names, off, top)
     if moves:
-        etree.SubElement(robot, "link", name=names.links[0])
+        build.links.append(Link(names.links[0], top.inner().at("link", names.links[0])))
     for body in bodies:
-        link = _link(robot, model, body, names.links[body], off[body])
-        _geoms(link, model, body, off[body], scratch)
-        if body != root_body or moves:
-            added += _joints(robot, model, body, names, off)
-        _sites(robot, model, body, names, off[body])
+        build.body(body, scratch, joints=body != root_body or moves)
     why = "added: a link between two joints of one MJCF body"
-    listed += [(f"links.{name}", why) for name in added]
+    listed += [(f"links.{name}", why) for name in build.added]
     source.closures = welds.closures(model, bodies, names.links)  # loops.close lists them
-    carried = {joint.get("listed") for joint in source.closures}
+    carried = {joint.listed for joint in source.closures}
     listed = [(what, reason) for what, reason in listed if what not in carried]
-    _lines(robot, source, root_body)
-    return robot, bool(floating), listed
+    links, joints = tuple(build.links), tuple(build.joints)
+    materials = tuple(g.material for link in links for g in link.visuals if g.material)
+    name = model.names[: model.names.find(b"\0")].decode() or "robot"
+    return Robot(top.at("robot", name), name, links, joints, materials), bool(floating), listed
 
 
-def _lines(robot, source: MjcfSource, root_body: int) -> None:
-    """Each element's `sourceline`: the MJCF line of the body, joint, geom or site it comes
-    from (reader.py `lines`, recorded in the `mjcf` attribute as KIND:ID), else its
-    parent element's; the `<robot>` the root body's. The report's records name it, and
-    provenance finds an element's records by line and element: so an element without a
-    name (a visual, a joint's limit) brought in by an `<include>`, whose line all it brings
-    in share, gets none."""
-    robot.sourceline = source.lines.get(("body", root_body)) or 0  # 0: none known
-    shared = set()
-    for element in robot.iter():
-        if element is robot:
-            continue
-        kind, _, index = (element.attrib.pop("mjcf", "") or ":").partition(":")
-        key = (kind, int(index)) if index else None
-        parent = element.getparent()
-        line = source.lines.get(key) if key else None
-        if key in source.included or (key is None and parent in shared):
-            shared.add(element)
-        if line is None and parent not in shared:
-            line = parent.sourceline
-        if element in shared and element.get("name") is None:
-            line = None
-        element.sourceline = line or 0
+@dataclass(frozen=True)
+class Place:
+    """Where a node is in the MJCF file: its `line` (None: none known) and whether an
+    `<include>` brought it in (`shared`: its line is the include's, which all it brings in
+    share). A node keeps the line of the body, joint, geom or site it comes from (reader.py
+    `lines`), else its parent node's; the robot the root body's. The report's records name
+    it, and provenance finds a node's records by line and element: so a node without a name
+    (a visual, a joint's limit) brought in by an `<include>` gets none."""
+
+    line: int | None
+    shared: bool = False
+
+    def at(self, tag: str, name: str | None = None) -> At:
+        """The node's `At`."""
+        return At(tag, name, self.line)
+
+    def inner(self) -> Place:
+        """The place of a node of no MJCF element of its own (an origin, a limit, a
+        material) inside this one."""
+        return Place(None if self.shared else self.line, self.shared)
+
+    def of(self, source: MjcfSource, key: tuple[str, int], named: bool) -> Place:
+        """The place of the MJCF element `key` (KIND, compiled id) inside this one."""
+        shared = key in source.included
+        line = source.lines.get(key) or None
+        if line is None and not self.shared:
+            line = self.line
+        return Place(None if shared and not named else line, shared)
 
 
 class Names:
@@ -173,73 +186,107 @@ class Names:
         return name
 
 
-def _link(robot, model, body: int, name: str, off: np.ndarray) -> object:
-    """`<link>` with its inertial (mass kg, CoM m and principal axes in the link frame)."""
-    from lxml import etree
+class Build:
+    """The links and joints of the robot's bodies, in the order of the bodies: each body's
+    link, the joints that hang it from its parent's (added links between several joints of
+    one body), then its sites' joints and links."""
 
-    link = etree.SubElement(robot, "link", name=name, mjcf=f"body:{body}")
-    if model.body_mass[body] > 0:
-        inertial = etree.SubElement(link, "inertial")
-        etree.SubElement(
-            inertial, "origin", xyz=fmt(model.body_ipos[body] - off),
-            rpy=fmt(rpy(quat_mat(model.body_iquat[body]))),
-        )  # fmt: skip
-        etree.SubElement(inertial, "mass", value=fmt([model.body_mass[body]]))
-        ixx, iyy, izz = model.body_inertia[body]
-        etree.SubElement(
-            inertial, "inertia", ixx=fmt([ixx]), iyy=fmt([iyy]), izz=fmt([izz]),
-            ixy="0", ixz="0", iyz="0",
-        )  # fmt: skip
-    return link
+    def __init__(self, source: MjcfSource, model, names: Names, off: np.ndarray, top: Place):
+        self.source, self.model, self.names, self.off, self.top = source, model, names, off, top
+        self.links: list[Link] = []
+        self.joints: list[Joint] = []
+        self.added: list[str] = []  # the links between two joints of one body
+
+    def body(self, body: int, scratch: Path, joints: bool) -> None:
+        """The body's link (inertial, geoms), its joints when `joints`, its sites."""
+        name = self.names.links[body]
+        place = self.top.of(self.source, ("body", body), True)
+        visuals, collisions = _geoms(self.source, self.model, body, self.off[body], place, scratch)
+        inertial = _inertial(self.model, body, self.off[body], place.inner())
+        self.links.append(Link(name, place.at("link", name), inertial, visuals, collisions))
+        if joints:
+            self._joints(body)
+        self._sites(body)
+
+    def _joints(self, body: int) -> None:
+        """The body's joints as a chain from its parent's link: the first joint's origin is
+        the body's pose (less the parent's offset); each later one sits at its own `pos`."""
+        model, names = self.model, self.names
+        parent = int(model.body_parentid[body])
+        pose_xyz = model.body_pos[body] - self.off[parent]
+        mat = quat_mat(model.body_quat[body])
+        start = np.zeros(3)
+        first = int(model.body_jntadr[body])
+        count = int(model.body_jntnum[body])
+        parent_link = names.links[parent]
+        if count == 0:
+            name, child = names.new(f"{names.links[body]}_joint"), names.links[body]
+            place = self.top.of(self.source, ("body", body), True)
+            origin = _pose(pose_xyz, mat, place.inner())
+            self.joints.append(
+                Joint(name, "fixed", place.at("joint", name), parent_link, child, origin)
+            )
+            return
+        for k, j in enumerate(range(first, first + count)):
+            kind = int(model.jnt_type[j])
+            at = model.jnt_pos[j] if kind in (HINGE, BALL) else start
+            place = self.top.of(self.source, ("jnt", j), True)
+            if k == count - 1:
+                child = names.links[body]
+            else:
+                child = names.new(f"{name_of(model, 'jnt', j)}_link")
+                self.links.append(Link(child, place.at("link", child)))
+                self.added.append(child)
+            turn, shift = _at_zero(model, j, kind)
+            if k == 0:
+                origin = _pose(pose_xyz + mat @ (at + shift), mat @ turn, place.inner())
+            else:
+                origin = _pose(at - start + shift, turn, place.inner())
+            name = name_of(model, "jnt", j)
+            joint = Joint(name, "fixed", place.at("joint", name), parent_link, child, origin)
+            self.joints.append(_kind(joint, model, j, kind, place.inner()))
+            parent_link, start = child, at
+
+    def _sites(self, body: int) -> None:
+        """Each named site: a massless leaf link on a fixed joint (a kit frame)."""
+        model, names, off = self.model, self.names, self.off[body]
+        for s in range(model.nsite):
+            if model.site_bodyid[s] != body or not model.site(s).name:
+                continue
+            name = names.new(model.site(s).name)
+            joint = names.new(f"{name}_joint")
+            place = self.top.of(self.source, ("site", s), True)
+            origin = _pose(model.site_pos[s] - off, quat_mat(model.site_quat[s]), place.inner())
+            self.joints.append(
+                Joint(joint, "fixed", place.at("joint", joint), names.links[body], name, origin)
+            )
+            self.links.append(Link(name, place.at("link", name)))
 
 
-def _origin(parent, xyz, mat) -> None:
-    """An `<origin>` (m, URDF rpy rad) under `parent`."""
-    from lxml import etree
-
-    etree.SubElement(parent, "origin", xyz=fmt(xyz), rpy=fmt(rpy(mat)))
+def floats(values) -> tuple[float, ...]:
+    """The numbers as plain floats (the model is typed: no numpy scalars)."""
+    return tuple(float(v) for v in np.ravel(values))
 
 
-def _joints(robot, model, body: int, names: Names, off: np.ndarray) -> list[str]:
-    """The body's joints as a chain from its parent's link: the first joint's origin is
-    the body's pose (less the parent's offset); each later one sits at its own `pos`."""
-    from lxml import etree
+def _pose(xyz, mat: np.ndarray, place: Place) -> Pose:
+    """An origin (m, URDF rpy rad) at `place`."""
+    return Pose(floats(xyz), floats(rpy(mat)), place.at("origin"))  # type: ignore[arg-type]
 
-    parent = int(model.body_parentid[body])
-    pose_xyz = model.body_pos[body] - off[parent]
-    mat = quat_mat(model.body_quat[body])
-    start, added = np.zeros(3), []
-    first = int(model.body_jntadr[body])
-    count = int(model.body_jntnum[body])
-    parent_link = names.links[parent]
-    if count == 0:
-        joint = etree.SubElement(robot, "joint", name=names.new(f"{names.links[body]}_joint"))
-        joint.set("type", "fixed")
-        joint.set("mjcf", f"body:{body}")
-        _origin(joint, pose_xyz, mat)
-        etree.SubElement(joint, "parent", link=parent_link)
-        etree.SubElement(joint, "child", link=names.links[body])
-        return added
-    for k, j in enumerate(range(first, first + count)):
-        kind = int(model.jnt_type[j])
-        at = model.jnt_pos[j] if kind in (HINGE, BALL) else start
-        if k == count - 1:
-            child = names.links[body]
-        else:
-            child = names.new(f"{name_of(model, 'jnt', j)}_link")
-            etree.SubElement(robot, "link", name=child, mjcf=f"jnt:{j}")
-            added.append(child)
-        joint = etree.SubElement(robot, "joint", name=name_of(model, "jnt", j), mjcf=f"jnt:{j}")
-        turn, shift = _at_zero(model, j, kind)
-        if k == 0:
-            _origin(joint, pose_xyz + mat @ (at + shift), mat @ turn)
-        else:
-            _origin(joint, at - start + shift, turn)
-        etree.SubElement(joint, "parent", link=parent_link)
-        etree.SubElement(joint, "child", link=child)
-        _kind(joint, model, j, kind)
-        parent_link, start = child, at
-    return added
+
+def _inertial(model, body: int, off: np.ndarray, place: Place) -> Inertial | None:
+    """The body's inertial (mass kg, CoM m and principal axes in the link frame; inertia
+    kg m^2 about them), None when massless."""
+    if not model.body_mass[body] > 0:
+        return None
+    ixx, iyy, izz = floats(model.body_inertia[body])
+    return Inertial(
+        place.at("inertial"),
+        _pose(model.body_ipos[body] - off, quat_mat(model.body_iquat[body]), place),
+        float(model.body_mass[body]),
+        place.at("mass"),
+        (ixx, iyy, izz, 0.0, 0.0, 0.0),
+        place.at("inertia"),
+    )
 
 
 def _at_zero(model, j: int, kind: int) -> tuple[np.ndarray, np.ndarray]:
@@ -255,37 +302,33 @@ def _at_zero(model, j: int, kind: int) -> tuple[np.ndarray, np.ndarray]:
     return turn, np.zeros(3)
 
 
-def _kind(joint, model, j: int, kind: int) -> None:
+def _kind(joint: Joint, model, j: int, kind: int, place: Place) -> Joint:
     """Type, axis, limits (rad or m; effort N m or N from the joint's actuators) and
     dynamics of one joint."""
-    from lxml import etree
-
+    if kind == BALL:
+        return replace(joint, type="spherical")
     limited = bool(model.jnt_limited[j])
     effort = mjcf_listed.effort(model, j)
-    if kind == BALL:
-        joint.set("type", "spherical")
-        return
-    joint.set("type", {HINGE: "revolute" if limited else "continuous", SLIDE: "prismatic"}[kind])
-    etree.SubElement(joint, "axis", xyz=fmt(model.jnt_axis[j]))
-    limit = {}
-    if limited:
-        limit = {"lower": fmt([model.jnt_range[j][0]]), "upper": fmt([model.jnt_range[j][1]])}
-    if effort is not None:
-        limit["effort"] = fmt([effort])
-    if limit:
-        etree.SubElement(joint, "limit", **limit)
+    kinds = {HINGE: "revolute" if limited else "continuous", SLIDE: "prismatic"}
+    lower, upper = floats(model.jnt_range[j]) if limited else (None, None)
+    limit = None
+    if limited or effort is not None:
+        limit = Limit(place.at("limit"), lower, upper, None if effort is None else float(effort))
     dof = int(model.jnt_dofadr[j])
-    damping, friction = model.dof_damping[dof], model.dof_frictionloss[dof]
-    if damping or friction:
-        etree.SubElement(joint, "dynamics", damping=fmt([damping]), friction=fmt([friction]))
+    damping, friction = float(model.dof_damping[dof]), float(model.dof_frictionloss[dof])
+    dynamics = Dynamics(place.at("dynamics"), damping, friction) if damping or friction else None
+    return replace(
+        joint, type=kinds[kind], axis=floats(model.jnt_axis[j]), axis_at=place.at("axis"),
+        limit=limit, dynamics=dynamics,
+    )  # fmt: skip
 
 
-def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
-    """Each geom of the body: a `<visual>` when it collides with nothing (contype =
-    conaffinity = 0), else a `<collision>`; shapes the URDF form has no word for are listed
-    by listed.py."""
-    from lxml import etree
-
+def _geoms(source: MjcfSource, model, body: int, off: np.ndarray, link: Place, scratch: Path):
+    """Each geom of the body: a visual when it collides with nothing (contype =
+    conaffinity = 0), else a collision; returns (visuals, collisions). Shapes the URDF
+    form has no word for are listed by listed.py."""
+    visuals: list[Geometry] = []
+    collisions: list[Geometry] = []
     for g in range(
         int(model.body_geomadr[body]), int(model.body_geomadr[body] + model.body_geomnum[body])
     ):
@@ -294,29 +337,33 @@ def _geoms(link, model, body: int, off: np.ndarray, scratch: Path) -> None:
             kind == MESH and mjcf_listed.flat(model, int(model.geom_dataid[g]))
         ):
             continue  # listed (listed.py)
-        tag = (
-            "visual"
-            if model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0
-            else "collision"
-        )
-        element = etree.SubElement(link, tag, mjcf=f"geom:{g}")
-        _origin(element, model.geom_pos[g] - off, quat_mat(model.geom_quat[g]))
-        geometry = etree.SubElement(element, "geometry")
-        size = model.geom_size[g]
-        if kind == SPHERE:
-            etree.SubElement(geometry, "sphere", radius=fmt([size[0]]))
-        elif kind in (CAPSULE, CYLINDER):
-            shape = "capsule" if kind == CAPSULE else "cylinder"
-            etree.SubElement(geometry, shape, radius=fmt([size[0]]), length=fmt([2 * size[1]]))
-        elif kind == BOX:
-            etree.SubElement(geometry, "box", size=fmt(2 * size))
-        else:
-            etree.SubElement(
-                geometry, "mesh", filename=str(_stl(model, int(model.geom_dataid[g]), scratch))
-            )
-        if tag == "visual":
-            material = etree.SubElement(element, "material", name=f"mjcf_geom{g}")
-            etree.SubElement(material, "color", rgba=fmt(_rgba(model, g)))
+        visual = model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0
+        tag = "visual" if visual else "collision"
+        place = link.of(source, ("geom", g), False)
+        inner = place.inner()
+        origin = _pose(model.geom_pos[g] - off, quat_mat(model.geom_quat[g]), inner)
+        shape = _shape(model, g, kind, inner, scratch)
+        material = None
+        if visual:
+            rgba = floats(_rgba(model, g))
+            material = Material(inner.at("material", f"mjcf_geom{g}"), f"mjcf_geom{g}", rgba)  # type: ignore[arg-type]
+        geometry = Geometry(place.at(tag), origin, shape, material)
+        (visuals if visual else collisions).append(geometry)
+    return tuple(visuals), tuple(collisions)
+
+
+def _shape(model, g: int, kind: int, place: Place, scratch: Path) -> Shape:
+    """The geom's shape (sizes m), a mesh written as STL into `scratch`."""
+    size = model.geom_size[g]
+    if kind == SPHERE:
+        return Shape("sphere", place.at("sphere"), radius=float(size[0]))
+    if kind in (CAPSULE, CYLINDER):
+        tag = "capsule" if kind == CAPSULE else "cylinder"
+        return Shape(tag, place.at(tag), radius=float(size[0]), length=float(2 * size[1]))
+    if kind == BOX:
+        return Shape("box", place.at("box"), size=floats(2 * size))  # type: ignore[arg-type]
+    filename = str(_stl(model, int(model.geom_dataid[g]), scratch))
+    return Shape("mesh", place.at("mesh"), filename=filename)
 
 
 def _rgba(model, g: int) -> np.ndarray:
@@ -341,19 +388,3 @@ def _stl(model, mesh: int, scratch: Path) -> Path:
     triangles = np.asarray(model.mesh_face[faces_at : faces_at + faces])
     trimesh.Trimesh(vertices, triangles, process=False).export(path)
     return path
-
-
-def _sites(robot, model, body: int, names: Names, off: np.ndarray) -> None:
-    """Each named site: a massless leaf link on a fixed joint (a kit frame)."""
-    from lxml import etree
-
-    for s in range(model.nsite):
-        if model.site_bodyid[s] != body or not model.site(s).name:
-            continue
-        name = names.new(model.site(s).name)
-        joint = etree.SubElement(robot, "joint", name=names.new(f"{name}_joint"), type="fixed")
-        joint.set("mjcf", f"site:{s}")
-        _origin(joint, model.site_pos[s] - off, quat_mat(model.site_quat[s]))
-        etree.SubElement(joint, "parent", link=names.links[body])
-        etree.SubElement(joint, "child", link=name)
-        etree.SubElement(robot, "link", name=name, mjcf=f"site:{s}")

@@ -10,16 +10,17 @@ as a kit leaves them out.
 
 from __future__ import annotations
 
+from simkit.importer.read.model import At, Joint
+
 #: mjtEq, mjtObj
 WELD, BODY = 1, 1
 
 
-def closures(model, bodies: list[int], links: dict[int, str]) -> list:
-    """A URDF-shaped fixed `<joint>` per body weld of `model` between two of `bodies` (or
-    the world, body 0): parent `body1`, child `body2` (held in body1's frame), named as
-    the equality (`eqN` without a name), at the equality's MJCF line where known."""
-    from lxml import etree
-
+def closures(model, bodies: list[int], links: dict[int, str]) -> list[Joint]:
+    """A fixed closure joint (read/model.py) per body weld of `model` between two of
+    `bodies` (or the world, body 0): parent `body1`, child `body2` (held in body1's frame),
+    named as the equality (`eqN` without a name), listed as `equality.NAME`; no source line
+    (the report names the weld by its listed name)."""
     kept = {0, *bodies}
     out = []
     for e in range(int(model.neq)):
@@ -29,9 +30,7 @@ def closures(model, bodies: list[int], links: dict[int, str]) -> list:
         if not set(ends) <= kept:
             continue
         name = model.eq(e).name or f"eq{e}"
-        joint = etree.Element("joint", name=name, type="fixed")
-        etree.SubElement(joint, "parent", link=links[ends[0]])
-        etree.SubElement(joint, "child", link=links[ends[1]])
-        joint.set("listed", f"equality.{name}")
-        out.append(joint)
+        parent, child = links[ends[0]], links[ends[1]]
+        listed = f"equality.{name}"
+        out.append(Joint(name, "fixed", At("joint", name), parent, child, listed=listed))
     return out
