@@ -13,6 +13,8 @@ its leader with multiplier 1 could never pass it."""
 
 from __future__ import annotations
 
+import math
+
 from simkit.emit import mjcf_world
 from simkit.emit.mjcf import MIMIC_TIMECONST_STEPS, TIMESTEP
 from simkit.emit.usd.common import axis_frame, prim_name
@@ -22,9 +24,11 @@ from simkit.model.robot import Joint, Robot
 
 def apply_mimic(prim, robot: Robot, joint: Joint) -> None:
     """PhysX couples q + gearing q_leader + offset = 0 (PxArticulationMimicJoint), so a URDF
-    mimic q = multiplier q_leader + offset has gearing -multiplier and offset -offset (rad or
-    m). Its compliance is the MJCF equality's solref (timeconst, damping ratio 1): natural
-    frequency 1 / timeconst (1/s), damping ratio 1."""
+    mimic q = multiplier q_leader + offset has gearing -multiplier and offset -offset, in the
+    USD's units, as omni.physx reads them: the offset in degrees for an angular follower (m
+    for a linear one), the gearing in follower units per leader unit (degrees for an angular
+    joint, so 1:1 between two of a kind). Its compliance is the MJCF equality's solref
+    (timeconst, damping ratio 1): natural frequency 1 / timeconst (1/s), damping ratio 1."""
     from pxr import Sdf
 
     leader, multiplier, offset = joint.mimic
@@ -40,8 +44,8 @@ def apply_mimic(prim, robot: Robot, joint: Joint) -> None:
     axis.Set(f"{_dof(lead)}{axis_frame(lead.axis)[0]}")
     timeconst = MIMIC_TIMECONST_STEPS * mjcf_world.timestep(robot, TIMESTEP)
     values = {
-        "gearing": -multiplier,
-        "offset": -offset,
+        "gearing": -multiplier * _unit(joint) / _unit(lead),
+        "offset": -offset * _unit(joint),
         "naturalFrequency": 1.0 / timeconst,
         "dampingRatio": 1.0,
     }
@@ -56,6 +60,11 @@ def driven_follower(robot: Robot, joint: Joint) -> bool:
     if joint.mimic is None or joint.type != "prismatic":
         return False
     return any(a.joint == joint.mimic[0] for a in robot.actuators)
+
+
+def _unit(joint: Joint) -> float:
+    """USD units per SI unit of the joint's coordinate: degrees per rad, or 1 (m)."""
+    return 1.0 if joint.type == "prismatic" else math.degrees(1.0)
 
 
 def _dof(joint: Joint) -> str:

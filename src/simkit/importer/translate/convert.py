@@ -296,7 +296,8 @@ def _check_mimics(source: Source, joints: list[dict], report: Report) -> None:
             report.dropped(
                 source,
                 _mimic_at(source, joint["name"]),
-                f"mimic of '{mimic['joint']}', not a movable joint: imported as independent",
+                f"'{joint['name']}' mimics '{mimic['joint']}', not a movable joint: "
+                "imported as independent",
             )
     first_leaders(source, joints, report)
     for joint in joints:

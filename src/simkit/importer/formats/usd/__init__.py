@@ -12,7 +12,8 @@ composes (issue 39).
   and the differences: the shared ones (formats/provenance.py) and the listed ones;
 - `EDITS`: a drive force apart from the joint's own effort limit kept as the spec's
   `drive_peak_torque_at_joint` (carry_servos); the armature the USD gives as the spec's
-  `armature` (carry_armatures; damping and friction travel as the URDF `<dynamics>`);
+  `armature` (carry_armatures; damping and friction travel as the URDF `<dynamics>`;
+  a follower's NewtonMimicAPI or PhysxMimicJointAPI as the URDF `<mimic>`, mimic.py);
 - `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
   (fixups/falling.py), as an MJCF's is.
 """
@@ -83,6 +84,8 @@ def read(shell: Source, options: ReadOptions) -> Source:
         source.note(Position("stage", None), note)
     for joint, why in dropped:
         source.note(Position(f"joint {joint.GetPath()}", None), f"not imported: {why}")
+    for where, why in ctx.notes:
+        source.note(Position(where, None), why)
     source.base = (
         floating,
         "floating base: no joint holds the USD's root body to the world; --fixed-base bolts it"

@@ -15,7 +15,8 @@ Joints: Revolute (limits in degrees -> rad; none or infinite: continuous), Prism
 Fixed, Spherical (the translation's three revolute joints); effort and velocity as
 limits.py reads them (`simkit:effortLimit`, else the drive's `maxForce`; PhysX's
 `maxJointVelocity` or Newton's `velocityLimit`, deg/s); damping, friction loss and armature
-as dynamics.py reads them (MjcPhysics, PhysX's armature; other Physics variants fill gaps).
+as dynamics.py reads them (MjcPhysics, PhysX's armature; other Physics variants fill gaps);
+a follower's `<mimic>` as mimic.py reads it (NewtonMimicAPI, PhysxMimicJointAPI).
 A joint with no body0 (or a body0 that is no rigid body) joins the robot to the world: on
 the root body a fixed one bolts the base (a `world` link), another moves it.
 Other joint types are read as fixed and listed; a drive's stiffness and damping are not read
@@ -37,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.usd import dynamics, limits, mjc, poses, shapes
+from simkit.importer.formats.usd import dynamics, limits, mimic, mjc, poses, shapes
 from simkit.importer.formats.usd.stage import Articulation, ends, stage_names
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
@@ -75,6 +76,8 @@ class Context:
     armatures: dict[str, float] = field(default_factory=dict)
     #: the stage composed with each other Physics variant, made on first need (dynamics.py)
     others: list | None = None
+    #: (where, why) report lines of mimics read as independent (mimic.py)
+    notes: list[tuple[str, str]] = field(default_factory=list)
 
 
 def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
@@ -353,6 +356,7 @@ def _joint(robot, joint, names, link_names, origin, ctx: Context, flip: bool = F
     etree.SubElement(element, "child", link=link_names[1])
     if kind in ("revolute", "prismatic"):
         _axis_limits(element, joint, kind, flip, ctx)
+        mimic.apply(element, joint, names, ctx.units, ctx.notes)
     if kind == "spherical":
         ctx.listed.append((f"joints.{name}.limits", "a spherical joint's cone limits: not read"))
 
