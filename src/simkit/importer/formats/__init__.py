@@ -32,6 +32,7 @@ from simkit.importer import read
 from simkit.importer.diagnostics import Report
 from simkit.importer.formats import mjcf, sdf, urdf, usd, xacro
 from simkit.importer.formats.urdf.model import robot_of
+from simkit.importer.read.model import infinite
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -117,6 +118,11 @@ def load(
     done = fmt.read(source, options)
     if done.robot is None:  # a reader that built a URDF-shaped document: read it once
         done.robot = robot_of(done)
+    bad = infinite(done.robot)  # a computed number (MuJoCo's, a stage's): refused once
+    if bad is not None:
+        at, attr, values = bad
+        shown = " ".join(repr(v) for v in values)
+        raise done.fail(at, f"'{attr}' needs {len(values)} finite numbers, got '{shown}'")
     for doc in (done, done.kept):
         doc.format, doc.noun = fmt.name, fmt.noun
     done.original = hashlib.sha256(path.read_bytes()).hexdigest()

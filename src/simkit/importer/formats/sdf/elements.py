@@ -1,16 +1,15 @@
 """The source-model pieces an SDF model's joints and frames share (tree.py, universal.py): a
 frame's pose in the model frame, an origin `Pose`, an axis in its joint frame
 (`expressed_in`), a joint's `Limit` and `Dynamics`, all numbers plain floats as the reader
-computed them; and the refusal of a computed number that is not finite (`finite`)."""
+computed them (one that is not finite is refused by formats.load: read/model.py
+`infinite`)."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
 from simkit.importer.formats.sdf.frames import MODEL, WORLD, inverse, numbers, rpy_of, scoped
-from simkit.importer.read.model import At, Dynamics, Limit, Pose, Robot
+from simkit.importer.read.model import At, Dynamics, Limit, Pose
 
 #: |limit| at or above which an SDF limit means none (the specification's default is 1e16)
 NO_LIMIT = 1e15
@@ -83,30 +82,3 @@ def limits(src, axis, kind: str, line: int | None) -> tuple[str, Limit | None, D
         out,
         Dynamics(At("dynamics", None, line), float(damping or 0), float(friction or 0)),
     )
-
-
-def finite(source, robot: Robot) -> Robot:
-    """The model, its computed numbers (poses, axes, damping) refused where one is not
-    finite, in one line at the node, in the order formats/urdf/model.py reads a document."""
-
-    def check(at, attr: str, values) -> None:
-        values = values if isinstance(values, tuple) else (values,)
-        if not all(math.isfinite(v) for v in values):
-            text = " ".join(repr(v) for v in values)
-            raise source.fail(at, f"'{attr}' needs {len(values)} finite numbers, got '{text}'")
-
-    def pose(p: Pose) -> None:
-        check(p.at, "xyz", p.xyz)
-        check(p.at, "rpy", p.rpy)
-
-    for link in robot.links:
-        for placed in ((link.inertial,) if link.inertial else ()) + link.visuals + link.collisions:
-            pose(placed.origin)
-    for joint in robot.joints:
-        pose(joint.origin)
-        if joint.axis is not None:
-            check(joint.axis_at, "xyz", joint.axis)
-        if joint.dynamics is not None:
-            check(joint.dynamics.at, "damping", joint.dynamics.damping)
-            check(joint.dynamics.at, "friction", joint.dynamics.friction)
-    return robot
