@@ -4,23 +4,24 @@ composes (issue 39).
 - `read`: every layer the file composes checked to lie inside the model's folder and to be
   USD before the stage opens (confine.py), the stage composed with the `Physics` variant the
   user names (`--variant`) or its default (stage.py), its one articulation found, then made
-  the tree the shared translation takes (tree.py, mass.py, shapes.py; meshes written as STL
-  into a scratch folder the import removes); the base floats unless a joint holds the root
-  body to the world; loop joints left out by the translation's `second_parents`
-  (translate/loops.py);
+  the source model the shared translation takes (`Source.robot`, read/model.py; tree.py,
+  mass.py, shapes.py; numbers as the floats computed, a non-finite one refused, finite.py;
+  meshes written as STL into a scratch folder the import removes); the base floats unless a
+  joint holds the root body to the world; loop joints left out by the translation's
+  `second_parents` (translate/loops.py); the model kept as a URDF document (`kept.root`,
+  formats/urdf/document.py) for the source differences (provenance.py);
 - `keep`: every layer as read, byte for byte (kept.py), the variant read in `source.args`,
   and the differences: the shared ones (formats/provenance.py) and the listed ones;
 - `EDITS`: a drive force apart from the joint's own effort limit kept as the spec's
   `drive_peak_torque_at_joint` (carry_servos); the armature the USD gives as the spec's
-  `armature` (carry_armatures; damping and friction travel as the URDF `<dynamics>`;
-  a follower's NewtonMimicAPI or PhysxMimicJointAPI as the URDF `<mimic>`, mimic.py);
+  `armature` (carry_armatures; damping and friction travel as the model's `Dynamics`;
+  a follower's NewtonMimicAPI or PhysxMimicJointAPI as its `Mimic`, mimic.py);
 - `AFTER`: a free base that falls on the kit's servos is marked as needing active balance
   (fixups/falling.py), as an MJCF's is.
 """
 
 from __future__ import annotations
 
-import copy
 import shutil
 import tempfile
 from dataclasses import dataclass, field, replace
@@ -28,7 +29,8 @@ from pathlib import Path
 
 from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
-from simkit.importer.formats.usd import confine, kept, stage, tree
+from simkit.importer.formats.urdf.document import document
+from simkit.importer.formats.usd import confine, finite, kept, stage, tree
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
@@ -63,7 +65,7 @@ class UsdSource(Source):
 
 
 def read(shell: Source, options: ReadOptions) -> Source:
-    """The composed stage's articulation as a URDF-shaped tree (module docstring)."""
+    """The composed stage's articulation as the source model (module docstring)."""
     allowed = (shell.path.resolve().parent, *(p.resolve() for p in options.allow_read))
     layers = confine.open_layers(shell.path, allowed)
     opened, variant = stage.open_stage(shell.path, layers.root, options.variant)
@@ -73,7 +75,8 @@ def read(shell: Source, options: ReadOptions) -> Source:
     source = UsdSource(shell.path, None, shell.packages, shell.report)
     source.scratch.append(scratch)
     try:
-        source.root, floating, listed, dropped, ctx = tree.to_tree(art, scratch)
+        robot, floating, listed, dropped, ctx = tree.to_robot(art, scratch)
+        source.robot = finite.check(source, robot)
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
@@ -92,7 +95,7 @@ def read(shell: Source, options: ReadOptions) -> Source:
         if floating
         else "fixed base: a joint holds the USD's root body to the world; --floating-base frees it",
     )
-    source.kept = replace(source, root=copy.deepcopy(source.root))
+    source.kept = replace(source, root=document(source.robot))  # provenance reads it
     return source
 
 

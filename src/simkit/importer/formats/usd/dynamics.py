@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from simkit.importer.formats.usd import poses
 from simkit.importer.formats.usd.stage import VARIANT_SET
+from simkit.importer.read.model import At, Dynamics
 
 #: spec key -> MjcPhysics attribute
 MJC = {"damping": "mjc:damping", "friction": "mjc:frictionloss", "armature": "mjc:armature"}
@@ -80,11 +81,10 @@ def of_joint(joint, kind: str, units: poses.Units, others: list) -> dict[str, fl
     return out
 
 
-def write(element, found: dict[str, float]) -> None:
-    """`<dynamics damping friction>` (N m s/rad and N m, or N s/m and N) under the URDF-shaped
-    `<joint>`, as the shared translation reads it; none where both are 0 or not given."""
-    from lxml import etree
-
-    if found.get("damping") or found.get("friction"):
-        values = {k: poses.fmt([found.get(k, 0.0)]) for k in ("damping", "friction")}
-        etree.SubElement(element, "dynamics", **values)
+def model(found: dict[str, float]) -> Dynamics | None:
+    """The joint's `Dynamics` (damping N m s/rad or N s/m, friction N m or N), as the shared
+    translation reads it; None where both are 0 or not given."""
+    if not (found.get("damping") or found.get("friction")):
+        return None
+    damping, friction = (float(found.get(k, 0.0)) for k in ("damping", "friction"))
+    return Dynamics(At("dynamics"), damping, friction)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simkit.importer.formats.usd import poses, shapes
+from simkit.importer.formats.usd import poses
 
 #: kg/m^3 where neither the body nor its colliders author a density (UsdPhysics' default)
 DEFAULT_DENSITY = 1000.0
@@ -19,13 +19,13 @@ DEFAULT_DENSITY = 1000.0
 UNSET = -1e30
 
 
-def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
+def of_body(prim, name: str, colliders: list, frame: np.ndarray, ctx) -> tuple | None:
     """(mass kg, CoM m, principal axes 3x3, principal moments kg m^2), all in the link
-    frame (`frame`: the link frame in the body frame); None when the body has neither a
-    mass nor a collider (the translation estimates it from its visual, and says so)."""
+    frame (`frame`: the link frame in the body frame) of link `name` with `colliders`
+    (shapes.Collider); None when the body has neither a mass nor a collider (the translation
+    estimates it from its visual, and says so)."""
     from pxr import UsdPhysics
 
-    owned = _owned(link)
     api = UsdPhysics.MassAPI(prim) if prim.HasAPI(UsdPhysics.MassAPI) else None
     kg = _value(api, "GetMassAttr", 0.0) * ctx.units.kilograms
     com = _value(api, "GetCenterOfMassAttr", None)
@@ -36,10 +36,10 @@ def of_body(prim, link, frame: np.ndarray, ctx) -> tuple | None:
     if kg <= 0 or com is None or diagonal is None:
         density = _value(api, "GetDensityAttr", 0.0) or DEFAULT_DENSITY
         density *= ctx.units.kilograms / ctx.units.meters**3
-        solid = _solid(owned, density)
+        solid = _solid(colliders, density)
         if solid is None and kg <= 0:
             return None
-    key = f"links.{link.get('name')}"
+    key = f"links.{name}"
     if kg <= 0:
         kg = solid[0]
         ctx.listed.append((f"{key}.mass", "no MassAPI mass: the colliders' solid at its density"))
@@ -78,32 +78,22 @@ def _value(api, getter: str, default):
     return float(value) if isinstance(default, float) else value
 
 
-def _owned(link) -> dict:
-    """Each `<collision>` -> (its shape's MassAPI density kg/m^3, mass kg; 0: not given),
-    the attributes shapes.py recorded them in taken off the element."""
-    out = {}
-    for collision in link.findall("collision"):
-        density = float(collision.attrib.pop(shapes.DENSITY, 0) or 0)
-        out[collision] = (density, float(collision.attrib.pop(shapes.MASS, 0) or 0))
-    return out
-
-
-def _solid(owned: dict, density: float) -> tuple[float, np.ndarray, np.ndarray] | None:
-    """(mass kg, CoM m, inertia about the CoM kg m^2) of the link's `<collision>` shapes
-    (link frame; `owned`: _owned's), each at its own MassAPI density or mass, else
+def _solid(colliders: list, density: float) -> tuple[float, np.ndarray, np.ndarray] | None:
+    """(mass kg, CoM m, inertia about the CoM kg m^2) of the link's collision shapes
+    (link frame; `colliders`: shapes.Collider), each at its own MassAPI density or mass, else
     `density`; primitives exactly, a mesh as its closed solid (else its convex hull). None
     without a collider of positive volume."""
     pieces = []
-    for collision, (own_density, own_mass) in owned.items():
-        own_density = own_density or density
-        piece = _piece(collision.find("geometry")[0])
+    for collider in colliders:
+        own_density = collider.density or density
+        piece = _piece(collider.geometry.shape)
         if piece is None or piece[0] <= 0:
             continue
         volume, centre, unit = piece
-        mass = own_mass or own_density * volume
-        origin = collision.find("origin")
-        xyz = np.array([float(v) for v in origin.get("xyz").split()])
-        turn = _rpy_matrix([float(v) for v in origin.get("rpy").split()])
+        mass = collider.mass or own_density * volume
+        origin = collider.geometry.origin
+        xyz = np.array(origin.xyz, dtype=float)
+        turn = _rpy_matrix(origin.rpy)
         pieces.append((mass, turn @ centre + xyz, turn @ (unit * mass / volume) @ turn.T))
     total = sum(p[0] for p in pieces)
     if total <= 0:
@@ -126,32 +116,32 @@ def _rpy_matrix(rpy) -> np.ndarray:
 
 def _piece(shape) -> tuple[float, np.ndarray, np.ndarray] | None:
     """(volume m^3, centroid m, inertia about the centroid at unit density kg m^2) of one
-    URDF geometry in its own frame; None for a shape without volume."""
+    model `Shape` in its own frame; None for a shape without volume."""
     import math
 
-    if shape.tag == "box":
-        a, b, c = (float(v) for v in shape.get("size").split())
+    if shape.kind == "box":
+        a, b, c = shape.size
         v = a * b * c
         return v, np.zeros(3), v / 12.0 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
-    if shape.tag == "sphere":
-        r = float(shape.get("radius"))
+    if shape.kind == "sphere":
+        r = shape.radius
         v = 4.0 / 3.0 * math.pi * r**3
         return v, np.zeros(3), np.eye(3) * 0.4 * v * r * r
-    if shape.tag in ("cylinder", "capsule"):
-        r, h = float(shape.get("radius")), float(shape.get("length"))
+    if shape.kind in ("cylinder", "capsule"):
+        r, h = shape.radius, shape.length
         vc = math.pi * r * r * h
         side, axial = vc * (3 * r * r + h * h) / 12.0, vc * r * r / 2.0
         v = vc
-        if shape.tag == "capsule":  # two hemispheres at the ends
+        if shape.kind == "capsule":  # two hemispheres at the ends
             vs = 4.0 / 3.0 * math.pi * r**3
             side += vs * (0.4 * r * r + h * h / 4.0 + 3.0 * h * r / 8.0)
             axial += vs * 0.4 * r * r
             v += vs
         return v, np.zeros(3), np.diag([side, side, axial])
-    if shape.tag == "mesh":
+    if shape.kind == "mesh":
         import trimesh
 
-        mesh = trimesh.load_mesh(shape.get("filename"))
+        mesh = trimesh.load_mesh(shape.filename)
         if not (mesh.is_watertight and mesh.volume > 0):
             mesh = mesh.convex_hull
         if mesh.volume <= 0:

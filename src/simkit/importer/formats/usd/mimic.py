@@ -1,7 +1,8 @@
-"""A USD mimic joint (a follower coupled to its leader) as the URDF `<mimic joint multiplier
-offset>` on the follower, q = multiplier q_leader + offset, so the shared translation takes it
-as it takes a URDF's (translate/joints.py; convert.py drops a mimic whose leader is no movable
-joint of the robot, with one report line, and imports the follower independent).
+"""A USD mimic joint (a follower coupled to its leader) as the model's `Mimic` (the URDF
+`<mimic joint multiplier offset>`) on the follower, q = multiplier q_leader + offset, so the
+shared translation takes it as it takes a URDF's (translate/joints.py; convert.py drops a
+mimic whose leader is no movable joint of the robot, with one report line, and imports the
+follower independent).
 
 Two schemas, neither registered with usd-core, so the applied schema is read from the prim's
 `apiSchemas` metadata and the attributes by name, each at its schema's fallback where not
@@ -31,6 +32,7 @@ from __future__ import annotations
 import math
 
 from simkit.importer.formats.usd import poses
+from simkit.importer.read.model import At, Mimic
 
 NEWTON = "NewtonMimicAPI"
 PHYSX = "PhysxMimicJointAPI:"
@@ -107,20 +109,13 @@ def _unit(joint, units: poses.Units) -> float:
     return math.radians(1.0)
 
 
-def apply(element, joint, names: dict[str, str], units: poses.Units, notes: list) -> None:
-    """`<mimic joint multiplier offset>` under the URDF-shaped `<joint>` where the joint prim
-    is a follower (`read`); a mimic that is no linear one adds (where, why) to `notes`."""
-    from lxml import etree
-
+def of(joint, names: dict[str, str], units: poses.Units, notes: list) -> Mimic | None:
+    """The follower's `Mimic` where the joint prim is one (`read`); a mimic that is no linear
+    one adds (where, why) to `notes`."""
     mimic, why = read(joint, names, units)
     if why is not None:
         notes.append((f"joint {joint.GetPath()}", why))
     if mimic is None:
-        return
-    etree.SubElement(
-        element,
-        "mimic",
-        joint=mimic["joint"],
-        multiplier=poses.fmt([mimic["multiplier"]]),
-        offset=poses.fmt([mimic["offset"]]),
-    )
+        return None
+    at = At("mimic")
+    return Mimic(at, mimic["joint"], float(mimic["multiplier"]), float(mimic["offset"]))

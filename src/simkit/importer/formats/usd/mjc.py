@@ -12,7 +12,9 @@ the factor is not known: left unapplied and listed.
 
 from __future__ import annotations
 
-from simkit.importer.formats.usd import poses
+from dataclasses import replace
+
+from simkit.importer.read.model import Link
 
 #: the MjcSceneAPI attribute: the model's total mass (kg; <= 0: not set)
 TOTAL_MASS = "mjc:compiler:setTotalMass"
@@ -30,28 +32,31 @@ def total_mass(stage) -> float:
     return 0.0
 
 
-def scale_to_total(robot, art, kilograms: float, listed: list) -> None:
-    """Scale each `<inertial>` of the URDF-shaped `robot` so the masses sum to the total
+def scale_to_total(links: list[Link], art, kilograms: float, listed: list) -> list[Link]:
+    """The `links` with each inertial's mass and inertia scaled so the masses sum to the total
     mass of the stage of `art` (stage.Articulation; `kilograms`: kg per stage mass unit);
     list what was done or why not."""
     total = total_mass(art.stage) * kilograms
     if total <= 0:
-        return
-    inertials = [(link.get("name"), link.find("inertial")) for link in robot.iter("link")]
-    inertials = [(name, el) for name, el in inertials if el is not None]
-    masses = [float(el.find("mass").get("value")) for _, el in inertials]
+        return links
+    masses = [link.inertial.mass for link in links if link.inertial is not None]
     if not _robot_only(art) or sum(masses) <= 0:
         why = "not applied: the stage has rigid bodies that are not the robot's"
         listed.append(("links.mass", f"MjcPhysics {TOTAL_MASS} {total:g} kg {why}"))
-        return
+        return links
     factor = total / sum(masses)
-    for (name, el), mass in zip(inertials, masses, strict=True):
-        el.find("mass").set("value", poses.fmt([mass * factor]))
-        inertia = el.find("inertia")
-        for key in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz"):
-            inertia.set(key, poses.fmt([float(inertia.get(key, "0")) * factor]))
-        why = f"scaled by {factor:.9g}: MjcPhysics {TOTAL_MASS} {total:g} kg (MuJoCo's rule)"
-        listed.extend([(f"links.{name}.mass", why), (f"links.{name}.inertia", why)])
+    out = []
+    for link in links:
+        inertial = link.inertial
+        if inertial is not None:
+            inertia = inertial.inertia
+            if inertia is not None:
+                inertia = tuple(float(v * factor) for v in inertia)
+            inertial = replace(inertial, mass=float(inertial.mass * factor), inertia=inertia)
+            why = f"scaled by {factor:.9g}: MjcPhysics {TOTAL_MASS} {total:g} kg (MuJoCo's rule)"
+            listed.extend([(f"links.{link.name}.mass", why), (f"links.{link.name}.inertia", why)])
+        out.append(replace(link, inertial=inertial))
+    return out
 
 
 def _robot_only(art) -> bool:

@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from simkit.importer.read.model import At, Pose
+
 
 @dataclass(frozen=True)
 class Units:
@@ -91,11 +93,16 @@ def fmt(values) -> str:
     return " ".join(repr(float(v)) for v in np.ravel(values))
 
 
-def origin(parent, t: np.ndarray) -> None:
-    """An `<origin>` (m, URDF rpy rad) of transform `t` under `parent`."""
-    from lxml import etree
+def floats(values) -> tuple[float, ...]:
+    """Numbers as plain floats (the model is typed), in order."""
+    return tuple(float(v) for v in np.ravel(values))
 
-    etree.SubElement(parent, "origin", xyz=fmt(t[:3, 3]), rpy=fmt(rpy(t[:3, :3])))
+
+def pose(t: np.ndarray) -> Pose:
+    """The model `Pose` (m, URDF rpy rad) of transform `t`; its place has no line (a
+    stage has none: every node's `At.sourceline` is None)."""
+    xyz, turn = floats(t[:3, 3]), floats(rpy(t[:3, :3]))
+    return Pose(xyz, turn, At("origin"))  # type: ignore[arg-type]
 
 
 #: USD value types stored as 32-bit floats: read back as the shortest decimal that gives

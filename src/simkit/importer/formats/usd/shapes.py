@@ -1,4 +1,4 @@
-"""A body's shapes as URDF `<collision>` and `<visual>` elements.
+"""A body's shapes as the model's collision and visual `Geometry` (read/model.py).
 
 Each prim below a rigid body (not below a nested one) that is a Cube, Sphere, Capsule,
 Cylinder or Mesh: with `PhysicsCollisionAPI` a collision, else (visible, purpose default or
@@ -23,17 +23,35 @@ as its own source.
 from __future__ import annotations
 
 import hashlib
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from simkit.importer.formats.urdf.model import PIECE_OF
 from simkit.importer.formats.usd import poses
+from simkit.importer.read.model import At, Geometry, Material, Shape
 
 SHAPES = ("Cube", "Sphere", "Capsule", "Cylinder", "Mesh")
-#: attributes on a `<collision>` holding its shape's MassAPI density and mass until mass.py
-#: takes them off (UsdPhysics: a collider's own MassAPI sets its share of the body's mass)
-DENSITY, MASS = "usd-density", "usd-mass"
+
+
+@dataclass
+class Collider:
+    """A collision `Geometry` and its shape's own MassAPI `density` (kg/m^3) and `mass` (kg),
+    0 where not given (UsdPhysics: a collider's own MassAPI sets its share of the body's
+    mass; mass.py reads them)."""
+
+    geometry: Geometry
+    density: float = 0.0
+    mass: float = 0.0
+
+
+@dataclass
+class Shapes:
+    """A body's shapes in its link frame: visuals, colliders, the mesh approximations met."""
+
+    visuals: list[Geometry] = field(default_factory=list)
+    colliders: list[Collider] = field(default_factory=list)
+    approximations: list[str] = field(default_factory=list)
 
 
 def prims_of(body, bodies: set[str]):
@@ -50,14 +68,14 @@ def prims_of(body, bodies: set[str]):
             yield prim
 
 
-def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
-    """Add the body's collisions and visuals to `link`; `frame`: the link frame in the body
-    frame (m); `ctx`: the tree's Context (cache, units, scratch). The approximations met."""
+def shapes(name: str, body, bodies: set[str], frame: np.ndarray, ctx) -> Shapes:
+    """The collisions and visuals of `body`, link `name`; `frame`: the link frame in the body
+    frame (m); `ctx`: the tree's Context (cache, units, scratch)."""
     from pxr import UsdGeom, UsdPhysics
 
-    notes = []
+    out = Shapes()
     to_link = poses.inv(frame)
-    meshes: dict[str, list] = {}  # parent prim path -> the collision mesh elements below it
+    meshes: dict[str, list] = {}  # parent prim path -> the indices of its collision meshes
     for prim in prims_of(body, bodies):
         full = poses.relative(ctx.cache, prim, body, ctx.units.meters)
         full = to_link @ full
@@ -68,47 +86,50 @@ def shapes(link, body, bodies: set[str], frame: np.ndarray, ctx) -> list[str]:
             and imageable.ComputePurpose() in (UsdGeom.Tokens.default_, UsdGeom.Tokens.render)
         )
         if collides:
-            element = _element(link, "collision", prim, full, ctx)
-            if element is not None and prim.HasAPI(UsdPhysics.MassAPI):
-                _own_mass(element, UsdPhysics.MassAPI(prim), ctx.units)
-            if element is not None and prim.GetTypeName() == "Mesh":
-                meshes.setdefault(str(prim.GetParent().GetPath()), []).append(element)
+            geometry = _geometry(name, "collision", prim, full, ctx)
+            if geometry is not None:
+                collider = Collider(geometry)
+                if prim.HasAPI(UsdPhysics.MassAPI):
+                    _own_mass(collider, UsdPhysics.MassAPI(prim), ctx.units)
+                if prim.GetTypeName() == "Mesh":
+                    where = str(prim.GetParent().GetPath())
+                    meshes.setdefault(where, []).append(len(out.colliders))
+                out.colliders.append(collider)
             if prim.HasAPI(UsdPhysics.MeshCollisionAPI):
                 how = UsdPhysics.MeshCollisionAPI(prim).GetApproximationAttr().Get()
-                notes.append(str(how or "none"))
+                out.approximations.append(str(how or "none"))
         elif shown:
-            element = _element(link, "visual", prim, full, ctx)
-            if element is not None:
-                _colour(element, prim)
+            geometry = _geometry(name, "visual", prim, full, ctx)
+            if geometry is not None:
+                out.visuals.append(replace(geometry, material=_colour(prim)))
     meshes.pop(str(body.GetPath()), None)
-    for parent, elements in sorted(meshes.items()):
-        _pieces(parent, elements)
-    return notes
+    for parent, indices in sorted(meshes.items()):
+        _pieces(parent, [out.colliders[k] for k in indices])
+    return out
 
 
-def _pieces(parent: str, elements: list) -> None:
+def _pieces(parent: str, colliders: list[Collider]) -> None:
     """Mark the collision meshes below one grouping prim `parent` as the pieces of one
     source (module docstring) where there are two or more and each is convex."""
     import trimesh
 
-    if len(elements) < 2:
+    if len(colliders) < 2:
         return
-    for element in elements:
-        path = element.find("geometry/mesh").get("filename")
+    for collider in colliders:
+        path = collider.geometry.shape.filename
         if not trimesh.load_mesh(path, file_type="stl").is_convex:
             return
-    for element in elements:
-        element.set(PIECE_OF, parent)
+    for collider in colliders:
+        collider.geometry = replace(collider.geometry, piece_of=parent)
 
 
-def _own_mass(element, api, units) -> None:
+def _own_mass(collider: Collider, api, units) -> None:
     """Record a collider's MassAPI density and mass (stage units to kg/m^3 and kg)."""
     density, mass = api.GetDensityAttr(), api.GetMassAttr()
     if density and density.HasAuthoredValue() and float(density.Get()) > 0:
-        value = float(density.Get()) * units.kilograms / units.meters**3
-        element.set(DENSITY, repr(value))
+        collider.density = float(density.Get()) * units.kilograms / units.meters**3
     if mass and mass.HasAuthoredValue() and float(mass.Get()) > 0:
-        element.set(MASS, repr(float(mass.Get()) * units.kilograms))
+        collider.mass = float(mass.Get()) * units.kilograms
 
 
 def _f32(values) -> np.ndarray:
@@ -116,29 +137,26 @@ def _f32(values) -> np.ndarray:
     return np.array([float(str(np.float32(v))) for v in np.ravel(values)])
 
 
-def _element(link, tag: str, prim, full: np.ndarray, ctx):
-    """One `<collision>` or `<visual>` of a shape prim (transform `full` in the link
-    frame, scale included); None for an empty or flat mesh (listed)."""
-    from lxml import etree
-
+def _geometry(name: str, tag: str, prim, full: np.ndarray, ctx) -> Geometry | None:
+    """One collision or visual `Geometry` (`tag`) of a shape prim of link `name` (transform
+    `full` in the link frame, scale included); None for an empty or flat mesh (listed)."""
     kind = prim.GetTypeName()
     pose, scale = rigid(full)
-    geometry = etree.Element("geometry")
     m = ctx.units.meters
     if kind == "Mesh":
         path = _stl(prim, full, ctx.scratch)
         if path is None:
-            what = f"links.{link.get('name')}.{tag}.{prim.GetName()}"
+            what = f"links.{name}.{tag}.{prim.GetName()}"
             ctx.listed.append((what, "a mesh with no faces or no volume (flat): left out"))
             return None
         pose = np.eye(4)
-        etree.SubElement(geometry, "mesh", filename=str(path))
+        shape = Shape("mesh", At("mesh"), filename=str(path))
     elif kind == "Cube":
         size = float(prim.GetAttribute("size").Get() or 2.0) * m * scale
-        etree.SubElement(geometry, "box", size=poses.fmt(_f32(size)))
+        shape = Shape("box", At("box"), size=poses.floats(_f32(size)))  # type: ignore[arg-type]
     elif kind == "Sphere":
         radius = float(prim.GetAttribute("radius").Get() or 1.0) * m * float(np.max(scale))
-        etree.SubElement(geometry, "sphere", radius=poses.fmt(_f32([radius])))
+        shape = Shape("sphere", At("sphere"), radius=poses.floats(_f32([radius]))[0])
     else:
         axis = str(prim.GetAttribute("axis").Get() or "Z")
         along = "XYZ".index(axis)
@@ -146,17 +164,9 @@ def _element(link, tag: str, prim, full: np.ndarray, ctx):
         radius = float(prim.GetAttribute("radius").Get() or 1.0) * m * float(max(across))
         height = float(prim.GetAttribute("height").Get() or 2.0) * m * float(scale[along])
         pose = pose @ poses.make(_z_to(axis), np.zeros(3))
-        etree.SubElement(
-            geometry,
-            kind.lower(),
-            radius=poses.fmt(_f32([radius])),
-            length=poses.fmt(_f32([height])),
-        )
-    element = etree.SubElement(link, tag, name=prim.GetName())
-    poses.origin(element, pose)
-    element.append(geometry)
-    element.sourceline = 0
-    return element
+        radius, height = poses.floats(_f32([radius, height]))
+        shape = Shape(kind.lower(), At(kind.lower()), radius=radius, length=height)
+    return Geometry(At(tag, prim.GetName()), poses.pose(pose), shape)
 
 
 def rigid(full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -215,9 +225,8 @@ def is_flat(points: np.ndarray) -> bool:
     return hull.is_empty() or hull.volume() <= 1e-9 * extent**3
 
 
-def _colour(element, prim) -> None:
-    """The visual's `<material>` colour (module docstring), when the stage gives one."""
-    from lxml import etree
+def _colour(prim) -> Material | None:
+    """The visual's `Material` colour (module docstring), when the stage gives one."""
     from pxr import UsdGeom, UsdShade
 
     rgba = None
@@ -234,7 +243,8 @@ def _colour(element, prim) -> None:
         shown = UsdGeom.Gprim(prim).GetDisplayColorAttr().Get()
         if shown is not None and len(shown):
             rgba = [*(float(c) for c in shown[0]), 1.0]
-    if rgba is not None:
-        name = f"usd_{hashlib.sha256(poses.fmt(rgba).encode()).hexdigest()[:8]}"
-        material_el = etree.SubElement(element, "material", name=name)
-        etree.SubElement(material_el, "color", rgba=poses.fmt(np.clip(rgba, 0.0, 1.0)))
+    if rgba is None:
+        return None
+    name = f"usd_{hashlib.sha256(poses.fmt(rgba).encode()).hexdigest()[:8]}"
+    clipped = poses.floats(np.clip(rgba, 0.0, 1.0))
+    return Material(At("material", name), name, clipped)  # type: ignore[arg-type]

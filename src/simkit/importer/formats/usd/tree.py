@@ -1,4 +1,5 @@
-"""A USD articulation (stage.py) to the URDF-shaped tree the shared translation takes.
+"""A USD articulation (stage.py) to the source model the shared translation takes (read/model.py
+`Robot`: links and joints in URDF terms, numbers as the floats computed here, no text).
 
 Frames: a UsdPhysics joint joins body0's frame `localPos0/localRot0` to body1's
 `localPos1/localRot1`, and turns about its `axis` (X, Y or Z) of that joint frame. A URDF
@@ -33,13 +34,14 @@ all scaled to MjcPhysics' `setTotalMass` where the stage sets it (mjc.py).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from simkit.importer.formats.usd import dynamics, limits, mimic, mjc, poses, shapes
 from simkit.importer.formats.usd.stage import Articulation, ends, stage_names
+from simkit.importer.read.model import At, Dynamics, Inertial, Joint, Limit, Link, Robot
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
 UNBOUNDED = 1e30
@@ -96,44 +98,51 @@ def local_pose(joint, end: int, ctx: Context) -> np.ndarray:
     return poses.make(turn, at * ctx.units.meters)
 
 
-def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list, Context]:
-    """(`<robot>`, floating base, listed (what, reason), dropped (joint prim, why), the
-    context: its `servos`, the drive forces apart from the joints' effort limits, and
+@dataclass
+class Built:
+    """The model's links and joints as the tree adds them, in the stage's order."""
+
+    links: list[Link] = field(default_factory=list)
+    joints: list[Joint] = field(default_factory=list)
+
+    def taken(self) -> set[str | None]:
+        return {link.name for link in self.links} | {joint.name for joint in self.joints}
+
+
+def to_robot(art: Articulation, scratch: Path) -> tuple[Robot, bool, list, list, Context]:
+    """(the source model, floating base, listed (what, reason), dropped (joint prim, why),
+    the context: its `servos`, the drive forces apart from the joints' effort limits, and
     `armatures`, {joint name: N m or N, kg m^2 or kg})."""
-    from lxml import etree
     from pxr import UsdGeom
 
     ctx = Context(art, poses.Units.of(art.stage), UsdGeom.XformCache(), scratch)
     every = stage_names(art.stage)
     ctx.names = {body: every["links"][body] for body in art.bodies}
     joint_names = every["joints"]
-    robot = etree.Element("robot", name=art.root_prim.GetName() or "robot")
-    robot.sourceline = 0
+    name = art.root_prim.GetName() or "robot"
+    built = Built()
     root = str(art.root_prim.GetPath())
     frames, order, loops, (base, world) = _walk(art, root, ctx)
     floating = base is None
     if base is not None:
-        etree.SubElement(robot, "link", name=WORLD).sourceline = 0
+        built.links.append(_bare(WORLD))
         origin = _world_origin(base, ctx)
         order = [*_chain(base, world, WORLD, ctx.names[root], False, origin, ctx), *order]
         for body, joint in sorted(ctx.bolts.items()):
             bolt = (joint, WORLD, ctx.names[body], False, _world_origin(joint, ctx))
             order.insert(1, bolt)
-    for body in art.bodies:
-        if body in frames:
-            _link(robot, body, frames[body], ctx)
-    mjc.scale_to_total(robot, art, ctx.units.kilograms, ctx.listed)
+    bodies = [_link(body, frames[body], ctx) for body in art.bodies if body in frames]
+    built.links += mjc.scale_to_total(bodies, art, ctx.units.kilograms, ctx.listed)
     for kind in ("links", "joints"):
         for path in art.apart.get(kind, []):
             why = "the scene's, not joined to the robot: not imported"
             ctx.listed.append((f"{kind}.{every[kind][path]}", why))
-    for name in ctx.added:
-        etree.SubElement(robot, "link", name=name)
+    built.links += [_bare(added) for added in ctx.added]
     for joint, parent, child, flip, origin in order:
-        _joint(robot, joint, joint_names, (parent, child), origin, ctx, flip)
+        built.joints.append(_joint(joint, joint_names, (parent, child), origin, ctx, flip))
     for body in art.bodies:
         if body in frames:
-            _frames(robot, body, frames[body], ctx)
+            _frames(built, body, frames[body], ctx)
     for joint in loops:
         a, b = ends(joint)
         if a in ctx.names and b in ctx.names:
@@ -141,13 +150,20 @@ def to_tree(art: Articulation, scratch: Path) -> tuple[object, bool, list, list,
             ctx.turns[id(joint)] = there[:3, :3]
             origin = poses.inv(frames.get(a, np.eye(4))) @ local_pose(joint, 0, ctx)
             origin = origin @ _turn_back(there)
-            _joint(robot, joint, joint_names, (ctx.names[a], ctx.names[b]), origin, ctx)
+            ends_ = (ctx.names[a], ctx.names[b])
+            built.joints.append(_joint(joint, joint_names, ends_, origin, ctx))
         else:
             ctx.dropped.append((joint, "joins the robot to the world away from its root"))
     _list_left_out(art, frames, every, ctx)
-    for element in robot.iter():
-        element.sourceline = element.sourceline or 0
+    links, joints = tuple(built.links), tuple(built.joints)
+    materials = tuple(g.material for link in links for g in link.visuals if g.material)
+    robot = Robot(At("robot", name), name, links, joints, materials)
     return robot, floating, ctx.listed, ctx.dropped, ctx
+
+
+def _bare(name: str) -> Link:
+    """A link with nothing in it (the world, an added or a frame link)."""
+    return Link(name, At("link", name))
 
 
 def _list_left_out(art: Articulation, frames: dict, every: dict, ctx: Context) -> None:
@@ -260,14 +276,13 @@ def _added(want: str, ctx: Context) -> str:
     return name
 
 
-def _frames(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
+def _frames(built: Built, body: str, frame: np.ndarray, ctx: Context) -> None:
     """Each Xform directly under the body with no shape and no body below it (a tool or
     sensor frame): a massless link on a fixed joint `NAME_joint`, at its pose (m)."""
-    from lxml import etree
     from pxr import Usd
 
     prim = ctx.art.stage.GetPrimAtPath(body)
-    taken = {e.get("name") for e in robot.iter("link", "joint")}
+    taken = built.taken()
     every = Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)
     for child in prim.GetFilteredChildren(every):
         if child.GetTypeName() != "Xform" or str(child.GetPath()) in ctx.names:
@@ -283,11 +298,10 @@ def _frames(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
         taken |= {name, joint_name}
         pose = poses.relative(ctx.cache, child, prim, ctx.units.meters)
         pose = poses.inv(frame) @ shapes.rigid(pose)[0]
-        joint = etree.SubElement(robot, "joint", name=joint_name, type="fixed")
-        poses.origin(joint, pose)
-        etree.SubElement(joint, "parent", link=ctx.names[body])
-        etree.SubElement(joint, "child", link=name)
-        etree.SubElement(robot, "link", name=name)
+        at = At("joint", joint_name)
+        origin = poses.pose(pose)
+        built.joints.append(Joint(joint_name, "fixed", at, ctx.names[body], name, origin))
+        built.links.append(_bare(name))
 
 
 def _world_origin(joint, ctx: Context) -> np.ndarray:
@@ -313,93 +327,98 @@ def _turn_back(pose: np.ndarray) -> np.ndarray:
     return poses.make(pose[:3, :3].T, np.zeros(3))
 
 
-def _link(robot, body: str, frame: np.ndarray, ctx: Context) -> None:
-    """`<link>` with its inertial (MassAPI, else the colliders' solid) and shapes."""
-    from lxml import etree
-
+def _link(body: str, frame: np.ndarray, ctx: Context) -> Link:
+    """The body's link with its inertial (MassAPI, else the colliders' solid) and shapes."""
     from simkit.importer.formats.usd import mass
 
     prim = ctx.art.stage.GetPrimAtPath(body)
-    link = etree.SubElement(robot, "link", name=ctx.names[body])
-    approximations = shapes.shapes(link, prim, set(ctx.art.bodies), frame, ctx)
-    for how in sorted(set(approximations) - {"none"}):
+    name = ctx.names[body]
+    found = shapes.shapes(name, prim, set(ctx.art.bodies), frame, ctx)
+    for how in sorted(set(found.approximations) - {"none"}):
         why = f"a mesh collider's approximation '{how}': the kit makes its own convex pieces"
-        ctx.listed.append((f"links.{ctx.names[body]}.collision", why))
-    found = mass.of_body(prim, link, frame, ctx)
+        ctx.listed.append((f"links.{name}.collision", why))
+    solid = mass.of_body(prim, name, found.colliders, frame, ctx)
+    collisions = tuple(c.geometry for c in found.colliders)
+    return Link(name, At("link", name), _inertial(solid), tuple(found.visuals), collisions)
+
+
+def _inertial(found: tuple | None) -> Inertial | None:
+    """The `Inertial` of mass.of_body's (kg, CoM, principal axes, moments): the inertia's
+    principal moments in the axes' frame, as the URDF reader reads an `<inertial>` (no
+    inertia where the mass is not positive)."""
     if found is None:
-        return
+        return None
     kg, com, rot, diagonal = found
-    inertial = etree.Element("inertial")
-    link.insert(0, inertial)
-    poses.origin(inertial, poses.make(rot, com))
-    etree.SubElement(inertial, "mass", value=poses.fmt([kg]))
-    ixx, iyy, izz = diagonal
-    etree.SubElement(
-        inertial, "inertia", ixx=poses.fmt([ixx]), iyy=poses.fmt([iyy]), izz=poses.fmt([izz]),
-        ixy="0", ixz="0", iyz="0",
-    )  # fmt: skip
+    mass = float(kg)
+    inertia = (*poses.floats(diagonal), 0.0, 0.0, 0.0) if mass > 0 else None
+    return Inertial(
+        At("inertial"),
+        poses.pose(poses.make(rot, com)),
+        mass,
+        At("mass"),
+        inertia,  # type: ignore[arg-type]
+        At("inertia"),
+    )
 
 
-def _joint(robot, joint, names, link_names, origin, ctx: Context, flip: bool = False) -> None:
-    """`<joint>` of a UsdPhysics joint between two links (flipped: written child-first)."""
-    from lxml import etree
-
+def _joint(joint, names, link_names, origin, ctx: Context, flip: bool = False) -> Joint:
+    """The `Joint` of a UsdPhysics joint between two links (flipped: written child-first)."""
     kind = KINDS.get(joint.GetTypeName())
     name = names[str(joint.GetPath())]
     if kind is None:
         why = f"a {joint.GetTypeName() or 'generic'} joint: read as fixed"
         ctx.listed.append((f"joints.{name}.type", why))
         kind = "fixed"
-    element = etree.SubElement(robot, "joint", name=name, type=kind)
-    poses.origin(element, origin)
-    etree.SubElement(element, "parent", link=link_names[0])
-    etree.SubElement(element, "child", link=link_names[1])
+    out = Joint(name, kind, At("joint", name), *link_names, poses.pose(origin))
     if kind in ("revolute", "prismatic"):
-        _axis_limits(element, joint, kind, flip, ctx)
-        mimic.apply(element, joint, names, ctx.units, ctx.notes)
+        out = _axis_limits(out, joint, flip, ctx)
+        out = replace(out, mimic=mimic.of(joint, names, ctx.units, ctx.notes))
     if kind == "spherical":
         ctx.listed.append((f"joints.{name}.limits", "a spherical joint's cone limits: not read"))
+    return out
 
 
-def _axis_limits(element, joint, kind: str, flip: bool, ctx: Context) -> None:
+def _axis_limits(out: Joint, joint, flip: bool, ctx: Context) -> Joint:
     """Axis (joint frame; flipped with the joint), limits (rad or m), effort, velocity."""
-    from lxml import etree
-
+    kind = out.type
     axis = np.zeros(3)
     axis["XYZ".index(str(joint.GetAttribute("physics:axis").Get() or "X"))] = -1.0 if flip else 1.0
     axis = ctx.turns.get(id(joint), np.eye(3)) @ axis
-    etree.SubElement(element, "axis", xyz=poses.fmt(np.where(np.abs(axis) < 1e-15, 0.0, axis)))
+    axis = poses.floats(np.where(np.abs(axis) < 1e-15, 0.0, axis))
     low = poses.get(joint, "physics:lowerLimit")
     high = poses.get(joint, "physics:upperLimit")
     bounded = all(v is not None and abs(float(v)) < UNBOUNDED for v in (low, high))
     scale = math.radians(1.0) if kind == "revolute" else ctx.units.meters
-    limit = {}
+    limit: dict[str, float] = {}
     if bounded:
-        limit = {
-            "lower": poses.fmt([float(low) * scale]),
-            "upper": poses.fmt([float(high) * scale]),
-        }
+        limit = {"lower": float(low) * scale, "upper": float(high) * scale}
     elif kind == "revolute":
-        element.set("type", "continuous")
+        out = replace(out, type="continuous")
     force = limits.effort(joint, kind, ctx.units)
     if force is not None:
-        limit["effort"] = poses.fmt([force])
+        limit["effort"] = float(force)
     servo = limits.servo_force(joint, kind, ctx.units)
     if servo is not None:
-        ctx.servos[element.get("name")] = servo
+        ctx.servos[out.name] = servo
     speed = limits.velocity(joint, kind)
     if speed is not None:
-        limit["velocity"] = poses.fmt([speed * scale])
-    if limit:
-        etree.SubElement(element, "limit", **limit)
-    _dynamics(element, joint, kind, ctx)
+        limit["velocity"] = float(speed * scale)
+    found = Limit(At("limit"), **limit) if limit else None
+    return replace(
+        out,
+        axis=axis,
+        axis_at=At("axis"),
+        limit=found,
+        dynamics=_dynamics(out.name, joint, kind, ctx),
+    )
 
 
-def _dynamics(element, joint, kind: str, ctx: Context) -> None:
-    """`<dynamics>` and the armature (kept for the spec) as dynamics.py reads them."""
+def _dynamics(name: str, joint, kind: str, ctx: Context) -> Dynamics | None:
+    """The joint's `Dynamics`, and its armature (kept for the spec), as dynamics.py reads
+    them."""
     if ctx.others is None:
         ctx.others = dynamics.variant_stages(ctx.art.stage, ctx.art.variant)
     found = dynamics.of_joint(joint, kind, ctx.units, ctx.others)
     if "armature" in found:
-        ctx.armatures[element.get("name")] = found["armature"]
-    dynamics.write(element, found)
+        ctx.armatures[name] = found["armature"]
+    return dynamics.model(found)
