@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from simkit.importer.formats.usd import poses
+from simkit.importer.read.model import At, Inertial
 
 #: kg/m^3 where neither the body nor its colliders author a density (UsdPhysics' default)
 DEFAULT_DENSITY = 1000.0
@@ -65,6 +66,25 @@ def of_body(prim, name: str, colliders: list, frame: np.ndarray, ctx) -> tuple |
     if np.linalg.det(turn) < 0:
         turn[:, 0] = -turn[:, 0]
     return kg, centre, turn, moments
+
+
+def inertial(found: tuple | None) -> Inertial | None:
+    """The `Inertial` of mass.of_body's (kg, CoM, principal axes, moments): the inertia's
+    principal moments in the axes' frame, as the URDF reader reads an `<inertial>` (no
+    inertia where the mass is not positive)."""
+    if found is None:
+        return None
+    kg, com, rot, diagonal = found
+    mass = float(kg)
+    inertia = (*poses.floats(diagonal), 0.0, 0.0, 0.0) if mass > 0 else None
+    return Inertial(
+        At("inertial"),
+        poses.pose(poses.make(rot, com)),
+        mass,
+        At("mass"),
+        inertia,  # type: ignore[arg-type]
+        At("inertia"),
+    )
 
 
 def _value(api, getter: str, default):

@@ -1,5 +1,6 @@
-"""A USD articulation (stage.py) to the source model the shared translation takes (read/model.py
-`Robot`: links and joints in URDF terms, numbers as the floats computed here, no text).
+"""A USD articulation (stage.py) to the source model the shared translation takes
+(read/model.py `Robot`: links and joints in URDF terms, numbers as the floats computed here,
+no text; a stage has no lines, so every node's place has none).
 
 Frames: a UsdPhysics joint joins body0's frame `localPos0/localRot0` to body1's
 `localPos1/localRot1`, and turns about its `axis` (X, Y or Z) of that joint frame. A URDF
@@ -41,7 +42,7 @@ import numpy as np
 
 from simkit.importer.formats.usd import dynamics, limits, mimic, mjc, poses, shapes
 from simkit.importer.formats.usd.stage import Articulation, ends, stage_names
-from simkit.importer.read.model import At, Dynamics, Inertial, Joint, Limit, Link, Robot
+from simkit.importer.read.model import At, Dynamics, Joint, Limit, Link, Robot
 
 #: |limit| at or above which a bound means none (USD writes +-inf or FLT_MAX)
 UNBOUNDED = 1e30
@@ -339,26 +340,7 @@ def _link(body: str, frame: np.ndarray, ctx: Context) -> Link:
         ctx.listed.append((f"links.{name}.collision", why))
     solid = mass.of_body(prim, name, found.colliders, frame, ctx)
     collisions = tuple(c.geometry for c in found.colliders)
-    return Link(name, At("link", name), _inertial(solid), tuple(found.visuals), collisions)
-
-
-def _inertial(found: tuple | None) -> Inertial | None:
-    """The `Inertial` of mass.of_body's (kg, CoM, principal axes, moments): the inertia's
-    principal moments in the axes' frame, as the URDF reader reads an `<inertial>` (no
-    inertia where the mass is not positive)."""
-    if found is None:
-        return None
-    kg, com, rot, diagonal = found
-    mass = float(kg)
-    inertia = (*poses.floats(diagonal), 0.0, 0.0, 0.0) if mass > 0 else None
-    return Inertial(
-        At("inertial"),
-        poses.pose(poses.make(rot, com)),
-        mass,
-        At("mass"),
-        inertia,  # type: ignore[arg-type]
-        At("inertia"),
-    )
+    return Link(name, At("link", name), mass.inertial(solid), tuple(found.visuals), collisions)
 
 
 def _joint(joint, names, link_names, origin, ctx: Context, flip: bool = False) -> Joint:
