@@ -92,10 +92,10 @@ def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"])
 """
 
 
-def _read(tmp_path, damping: str = "0.3"):
+def _read(tmp_path, damping: str = "0.3", colour: str = "0.2"):
     """The USD reader alone (no `formats.load`), its scratch folder removed after."""
     path = tmp_path / "bot.usda"
-    path.write_text(STAGE.replace("DAMPING", damping))
+    path.write_text(STAGE.replace("DAMPING", damping).replace("(0.2,", f"({colour},"))
     options = ReadOptions()
     source = usd.read(read_shell.shell(path, (), Report(Policy()), options), options)
     for scratch in source.scratch:
@@ -150,9 +150,14 @@ def test_the_kept_document_is_the_model_written(tmp_path):
     assert not {key for key in keys if key.startswith(("usd-", "simkit-"))}
 
 
-def test_a_number_that_is_not_finite_is_refused_in_one_line(tmp_path):
-    """An infinite MjcPhysics damping: refused in one line naming the file and the field."""
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [({"damping": "inf"}, "dynamics: 'damping'"), ({"colour": "nan"}, "color: 'rgba'")],
+)
+def test_a_number_that_is_not_finite_is_refused_in_one_line(tmp_path, change, words):
+    """An infinite MjcPhysics damping, a NaN colour: refused in one line naming the file and
+    the field as the URDF reader named it (a colour's `<color>`)."""
     with pytest.raises(SpecError) as caught:
-        _read(tmp_path, damping="inf")
+        _read(tmp_path, **change)
     text = str(caught.value)
-    assert "bot.usda" in text and "damping" in text and "finite" in text and "\n" not in text
+    assert "bot.usda: " in text and words in text and "finite" in text and "\n" not in text

@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import math
 
-from simkit.importer.read.model import Geometry, Pose, Robot
+from simkit.importer.read.model import At, Geometry, Pose, Robot
 
 INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+#: where a material's rgba is (the document's `<color>`, which the model does not keep)
+COLOR = At("color")
 
 
 def check(source, robot: Robot) -> Robot:
@@ -35,10 +37,10 @@ def check(source, robot: Robot) -> Robot:
             if shape is not None and getattr(shape, attr) is not None:
                 numbers(shape.at, attr, getattr(shape, attr))
         if g.material is not None and g.material.rgba is not None:
-            numbers(g.material.at, "rgba", g.material.rgba)
+            numbers(COLOR, "rgba", g.material.rgba)
 
     for material in robot.materials:
-        numbers(material.at, "rgba", material.rgba)
+        numbers(COLOR, "rgba", material.rgba)
     for link in robot.links:
         inertial = link.inertial
         if inertial is not None:  # the reader reads the mass and inertia before the origin
