@@ -2,7 +2,7 @@
 `read` sets `source.robot` with its numbers as plain floats (no text round trip) and no
 source lines (a stage has none), the kept document the source differences read is that
 model written as a URDF (and reads back to it), and a number that is not finite is refused
-in one line where the URDF reader refused it (finite.py)."""
+in one line where the URDF reader refused it (formats/finite.py, in formats.load)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from dataclasses import replace
 import pytest
 
 from simkit.errors import SpecError
+from simkit.importer import formats
 from simkit.importer import read as read_shell
 from simkit.importer.diagnostics import Policy, Report
 from simkit.importer.formats import usd
@@ -157,7 +158,10 @@ def test_the_kept_document_is_the_model_written(tmp_path):
 def test_a_number_that_is_not_finite_is_refused_in_one_line(tmp_path, change, words):
     """An infinite MjcPhysics damping, a NaN colour: refused in one line naming the file and
     the field as the URDF reader named it (a colour's `<color>`)."""
-    with pytest.raises(SpecError) as caught:
-        _read(tmp_path, **change)
+    path = tmp_path / "bot.usda"
+    damping, colour = change.get("damping", "0.3"), change.get("colour", "0.2")
+    path.write_text(STAGE.replace("DAMPING", damping).replace("(0.2,", f"({colour},"))
+    with pytest.raises(SpecError) as caught:  # formats.load: formats/finite.py
+        formats.load(path, report=Report(Policy()))
     text = str(caught.value)
     assert "bot.usda: " in text and words in text and "finite" in text and "\n" not in text

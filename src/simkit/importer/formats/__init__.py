@@ -24,15 +24,15 @@ from __future__ import annotations
 
 import hashlib
 import re
+import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from simkit.importer import read
 from simkit.importer.diagnostics import Report
-from simkit.importer.formats import mjcf, sdf, urdf, usd, xacro
+from simkit.importer.formats import finite, mjcf, sdf, urdf, usd, xacro
 from simkit.importer.formats.urdf.model import robot_of
-from simkit.importer.read.model import infinite
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
 
@@ -116,13 +116,15 @@ def load(
     source = read.shell(path, package_dirs, report, options)
     fmt = (picked or pick(path)).format
     done = fmt.read(source, options)
-    if done.robot is None:  # a reader that built a URDF-shaped document: read it once
-        done.robot = robot_of(done)
-    bad = infinite(done.robot)  # a computed number (MuJoCo's, a stage's): refused once
-    if bad is not None:
-        at, attr, values = bad
-        shown = " ".join(repr(v) for v in values)
-        raise done.fail(at, f"'{attr}' needs {len(values)} finite numbers, got '{shown}'")
+    try:
+        if done.robot is None:  # a reader that built a URDF-shaped document: read it once
+            done.robot = robot_of(done)
+        else:  # a model the reader computed: a number that is not finite is refused once
+            finite.check(done, done.robot)
+    except BaseException:  # refused: what the reader wrote for the translation goes
+        for folder in done.scratch:
+            shutil.rmtree(folder, ignore_errors=True)
+        raise
     for doc in (done, done.kept):
         doc.format, doc.noun = fmt.name, fmt.noun
     done.original = hashlib.sha256(path.read_bytes()).hexdigest()

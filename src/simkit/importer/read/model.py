@@ -17,7 +17,6 @@ Each node keeps `at`, where it is in the source (tag, name, line), for report li
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 Vec3 = tuple[float, float, float]
@@ -217,46 +216,3 @@ class Robot:
                 joints.setdefault(joint.name, joint)
             self._by_name.update(links=links, joints=joints)
         return self._by_name["links"], self._by_name["joints"]
-
-
-def infinite(robot: Robot) -> tuple[At | None, str, tuple[float, ...]] | None:
-    """The first number of the model that is not finite, as (where, attribute, its values),
-    in document order (links, then joints); None when every number is finite. A reader that
-    computes the model (a compiled MJCF, a USD stage, SDFormat's frames) is refused there
-    in one line, as the URDF reader refuses such a number in the text."""
-    for at, attr, values in _numbers(robot):
-        values = values if isinstance(values, tuple) else (values,)
-        if not all(math.isfinite(v) for v in values if v is not None):
-            return at, attr, values
-    return None
-
-
-def _numbers(robot: Robot):
-    """(where, attribute, value or values) of every number of the model, in order."""
-
-    def pose(pose: Pose, owner: At | None):
-        yield pose.at or owner, "xyz", pose.xyz
-        yield pose.at or owner, "rpy", pose.rpy
-
-    for link in robot.links:
-        if link.inertial is not None:
-            inertial = link.inertial
-            yield from pose(inertial.origin, inertial.at)
-            yield inertial.mass_at or inertial.at, "value", inertial.mass
-            yield inertial.inertia_at or inertial.at, "inertia", inertial.inertia or ()
-        for geometry in link.visuals + link.collisions:
-            yield from pose(geometry.origin, geometry.at)
-            shape = geometry.shape
-            if shape is not None:
-                for attr in ("size", "radius", "length", "scale"):
-                    yield shape.at, attr, getattr(shape, attr)
-    for joint in robot.joints:
-        yield from pose(joint.origin, joint.at)
-        yield joint.axis_at or joint.at, "xyz", joint.axis or ()
-        for part, attrs in (
-            (joint.limit, ("lower", "upper", "effort", "velocity", "twist")),
-            (joint.dynamics, ("damping", "friction")),
-            (joint.mimic, ("multiplier", "offset")),
-        ):
-            for attr in attrs if part is not None else ():
-                yield part.at, attr, getattr(part, attr)

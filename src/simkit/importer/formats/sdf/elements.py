@@ -1,8 +1,7 @@
 """The source-model pieces an SDF model's joints and frames share (tree.py, universal.py): a
 frame's pose in the model frame, an origin `Pose`, an axis in its joint frame
 (`expressed_in`), a joint's `Limit` and `Dynamics`, all numbers plain floats as the reader
-computed them (one that is not finite is refused by formats.load: read/model.py
-`infinite`)."""
+computed them (one that is not finite is refused by formats.load: formats/finite.py)."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ composes (issue 39).
   USD before the stage opens (confine.py), the stage composed with the `Physics` variant the
   user names (`--variant`) or its default (stage.py), its one articulation found, then made
   the source model the shared translation takes (`Source.robot`, read/model.py; tree.py,
-  mass.py, shapes.py; numbers as the floats computed, a non-finite one refused, finite.py;
+  mass.py, shapes.py; numbers as the floats computed (one not finite: refused by formats/finite.py);
   meshes written as STL into a scratch folder the import removes); the base floats unless a
   joint holds the root body to the world; loop joints left out by the translation's
   `second_parents` (translate/loops.py); the model kept as a URDF document (`kept.root`,
@@ -30,7 +30,7 @@ from pathlib import Path
 from simkit.importer.fixups import falling, settle
 from simkit.importer.formats import provenance
 from simkit.importer.formats.urdf.document import document
-from simkit.importer.formats.usd import confine, finite, kept, stage, tree
+from simkit.importer.formats.usd import confine, kept, stage, tree
 from simkit.importer.read.lenient import Position
 from simkit.importer.read.options import ReadOptions
 from simkit.importer.read.source import Source
@@ -76,7 +76,7 @@ def read(shell: Source, options: ReadOptions) -> Source:
     source.scratch.append(scratch)
     try:
         robot, floating, listed, dropped, ctx = tree.to_robot(art, scratch)
-        source.robot = finite.check(source, robot)
+        source.robot = robot
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise

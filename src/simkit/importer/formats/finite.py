@@ -1,9 +1,9 @@
-"""The source model's numbers refused where one is not finite, as the URDF reader refused the
-text the USD reader wrote before it built the model itself (formats/urdf/model.py `floats`):
-one line at the first such node, in the order that reader reads a document (materials, then
-each link's inertial, visuals and collisions, then each joint), so a stage with a NaN or an
-infinite value is refused in the same words. A mass that is not positive (NaN included) is
-no mass, so its inertia is not read, as there.
+"""A source model a reader computed (a compiled MJCF, SDFormat's frames, a USD stage), its
+numbers refused where one is not finite, as the URDF reader refuses such text
+(formats/urdf/model.py `floats`): one line at the first such node, in the order that reader
+reads a document (materials, then each link's inertial, visuals and collisions, then each
+joint), in its words. A mass that is not positive (NaN included) is no mass, so its inertia
+is not read, as there. `formats.load` runs it on every model a reader built itself.
 """
 
 from __future__ import annotations
