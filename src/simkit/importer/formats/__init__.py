@@ -5,9 +5,10 @@ Each format gives:
   comments and processing instructions, read once by `pick` for every format);
 - `title(head)`: the name the file gives its robot, or None (the spec's default name);
 - `read(shell, options)`: the read `Source` (importer/read/source.py) with its source model
-  `robot` (read/model.py, the one model every format gives the translation; a reader that
-  builds a URDF-shaped document instead leaves it None and `load` reads the document with
-  formats/urdf/model.py), `kept` (the document as read) and `format` set;
+  `robot` (read/model.py, the one model every format gives the translation, numbers as
+  numbers: MJCF, SDFormat and USD build it; the URDF and xacro readers leave it None and
+  `load` reads their document with formats/urdf/model.py), `kept` (the document as read)
+  and `format` set;
 - `keep(draft)`: the kept source written beside the spec and the spec's `source` and
   `source_differences` (formats/provenance.py);
 - `edits` and `after`: the format's own draft steps, run right after the translation
@@ -117,7 +118,7 @@ def load(
     fmt = (picked or pick(path)).format
     done = fmt.read(source, options)
     try:
-        if done.robot is None:  # a reader that built a URDF-shaped document: read it once
+        if done.robot is None:  # a URDF document (URDF, xacro): read into the model once
             done.robot = robot_of(done)
         else:  # a model the reader computed: a number that is not finite is refused once
             finite.check(done, done.robot)

@@ -9,8 +9,9 @@ dynamics and mimic of a joint that does not move, a fixed or continuous joint's 
 limits, a spherical joint's axis (PyBullet ignores it). A `<mass>` that is no number
 reads as massless (as urdfdom's bodies without mass).
 
-The MJCF and USD readers build a URDF-shaped document from their own model (SDFormat: none)
-and read it here, so the translation has one model to read.
+The URDF and xacro readers read their document here. The MJCF, SDFormat and USD readers
+build the model themselves from their own data (formats/finite.py then refuses a computed
+number that is not finite); `document.py` writes a model back as a URDF document.
 """
 
 from __future__ import annotations
