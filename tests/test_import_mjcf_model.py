@@ -5,12 +5,12 @@ document, which reads back to the same model."""
 
 from __future__ import annotations
 
-import dataclasses
 import shutil
 from dataclasses import replace
 
 import pytest
 
+import model_numbers
 from mjcf_models import arm, write
 from simkit.importer import read
 from simkit.importer.diagnostics import Policy, Report
@@ -52,24 +52,11 @@ def reading(tmp_path):
         shutil.rmtree(folder, ignore_errors=True)
 
 
-def _numbers(node, path="robot"):
-    """Every number in a model node, with where it is."""
-    if dataclasses.is_dataclass(node):
-        for f in dataclasses.fields(node):
-            if f.compare:  # not the robot's name index
-                yield from _numbers(getattr(node, f.name), f"{path}.{f.name}")
-    elif isinstance(node, (tuple, list)):
-        for i, item in enumerate(node):
-            yield from _numbers(item, f"{path}[{i}]")
-    elif not isinstance(node, (str, bool, type(None))):
-        yield path, node
-
-
 def test_the_reader_builds_the_model_with_plain_floats(reading):
     source = reading(arm())
     robot = source.robot
     assert robot is not None and robot.name == "arm"
-    numbers = [(where, v) for where, v in _numbers(robot) if not where.endswith("sourceline")]
+    numbers = model_numbers.numbers(robot)
     assert numbers and [(w, v) for w, v in numbers if type(v) is not float] == []
     joint = robot.joint("j1")
     assert (joint.type, joint.parent, joint.child) == ("revolute", "base", "link1")

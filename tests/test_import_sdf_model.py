@@ -5,12 +5,12 @@ and a number the frame arithmetic makes that is not finite is refused in one lin
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import replace
 from pathlib import Path
 
 import pytest
 
+import model_numbers
 from simkit.errors import SpecError
 from simkit.importer import formats
 from simkit.importer import read as read_shell
@@ -29,25 +29,12 @@ def _read(path: Path):
     return sdf.read(read_shell.shell(path, (), Report(Policy()), options), options)
 
 
-def _numbers(node, path: str = "robot"):
-    """Every number of a model node, with where it is."""
-    if dataclasses.is_dataclass(node):
-        for f in dataclasses.fields(node):
-            if f.compare:
-                yield from _numbers(getattr(node, f.name), f"{path}.{f.name}")
-    elif isinstance(node, tuple):
-        for i, value in enumerate(node):
-            yield from _numbers(value, f"{path}[{i}]")
-    elif not isinstance(node, (str, bool, type(None))):
-        yield path, node
-
-
 @pytest.mark.parametrize("name", ["frames.sdf", "universal.sdf", "world.sdf", "scopes.sdf"])
 def test_the_reader_gives_the_model_numbers_as_floats(name):
     """The reader's own `Robot`, each number a plain float (line numbers aside)."""
     robot = _read(FILES / name).robot
     assert isinstance(robot, Robot) and robot.joints
-    found = [(p, v) for p, v in _numbers(robot) if not p.endswith("sourceline")]
+    found = model_numbers.numbers(robot)
     assert found and all(type(v) is float for _, v in found), found[:3]
 
 

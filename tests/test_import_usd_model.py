@@ -6,12 +6,12 @@ in one line where the URDF reader refused it (formats/finite.py, in formats.load
 
 from __future__ import annotations
 
-import dataclasses
 import shutil
 from dataclasses import replace
 
 import pytest
 
+import model_numbers
 from simkit.errors import SpecError
 from simkit.importer import formats
 from simkit.importer import read as read_shell
@@ -104,24 +104,11 @@ def _read(tmp_path, damping: str = "0.3", colour: str = "0.2"):
     return source
 
 
-def _numbers(node, path: str = "robot"):
-    """Every number and every source line of a model node, with where it is."""
-    if dataclasses.is_dataclass(node):
-        for f in dataclasses.fields(node):
-            if f.compare:
-                yield from _numbers(getattr(node, f.name), f"{path}.{f.name}")
-    elif isinstance(node, tuple):
-        for i, value in enumerate(node):
-            yield from _numbers(value, f"{path}[{i}]")
-    elif not isinstance(node, (str, bool, type(None))) or path.endswith("sourceline"):
-        yield path, node
-
-
 def test_the_reader_gives_the_model_numbers_as_floats(tmp_path):
     """The reader's own `Robot`: each number a plain float, no source line anywhere."""
     robot = _read(tmp_path).robot
     assert isinstance(robot, Robot) and [j.name for j in robot.joints][-2:] == ["hinge", "follow"]
-    found = list(_numbers(robot))
+    found = list(model_numbers.values(robot))
     lines = [(p, v) for p, v in found if p.endswith("sourceline")]
     numbers = [(p, v) for p, v in found if not p.endswith("sourceline")]
     assert lines and all(v is None for _, v in lines), lines[:3]
