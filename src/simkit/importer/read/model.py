@@ -98,7 +98,7 @@ class Material:
 class Geometry:
     """A `<visual>` or `<collision>`: its pose in the link frame, its shape (None: none
     given), its material (visuals) and `piece_of`, the one source several convex pieces
-    come from (a USD's split collision mesh; formats/urdf/model.py PIECE_OF)."""
+    come from (a USD's split collision mesh: formats/usd/shapes.py)."""
 
     at: At
     origin: Pose = Pose()

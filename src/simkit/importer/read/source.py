@@ -15,6 +15,7 @@ from pathlib import Path
 from simkit.errors import SpecError
 from simkit.importer.diagnostics import Diagnostic, Report, describe, line_of
 from simkit.importer.read.lenient import Position
+from simkit.importer.read.model import Joint, Robot
 from simkit.importer.read.packages import MissingMesh, PackageMap
 
 __all__ = ["MissingMesh", "Position", "Source", "describe", "line_of", "resolve_uri"]
@@ -45,10 +46,10 @@ class Source:
     noun: str = "URDF"
     #: joints taken out of the tree because their child already hangs from an earlier one
     #: (a closed loop, importer/translate/loops.py): each becomes a spec `loops` weld
-    closures: list = field(default_factory=list)
+    closures: list[Joint] = field(default_factory=list)
     #: the source model the translation reads (read/model.py `Robot`), numbers as numbers:
     #: set once the format's reader is done (formats.load)
-    robot: object = None
+    robot: Robot | None = None
 
     @property
     def a_noun(self) -> str:

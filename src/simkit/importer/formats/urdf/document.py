@@ -46,15 +46,11 @@ def _unread(parent, places) -> None:
         _child(parent, at.tag, at, name=at.name)
 
 
-def _add(parent, tag: str, attrs: dict | None = None):
-    """A child element; attributes whose value is None are left out."""
-    values = {k: v if isinstance(v, str) else text(v) for k, v in (attrs or {}).items()}
-    return parent.makeelement(tag, {k: v for k, v in values.items() if v != "None"})
-
-
 def _child(parent, tag: str, at=None, **attrs):
-    """A child element, its source line `at`'s (an `At`; None: its parent's)."""
-    element = _add(parent, tag, {k: v for k, v in attrs.items() if v is not None})
+    """A child element, its source line `at`'s (an `At`; None: its parent's); attributes
+    whose value is None are left out, numbers written by `text`."""
+    values = {k: v if isinstance(v, str) else text(v) for k, v in attrs.items() if v is not None}
+    element = parent.makeelement(tag, values)
     parent.append(element)
     _line(element, at if at is not None else parent)
     return element

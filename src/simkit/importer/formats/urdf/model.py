@@ -35,9 +35,7 @@ from simkit.importer.read.model import (
 )
 from simkit.importer.read.source import Source
 
-#: a `<collision>` attribute a reader sets on the convex pieces of one source (a USD's
-#: sibling collision meshes under one grouping prim: formats/usd/shapes.py)
-PIECE_OF = "simkit-piece-of"
+TOP = ("link", "joint", "material")
 LINK_KEEPS = {"inertial", "visual", "collision"}
 JOINT_KEEPS = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 #: the joint types whose axis, limits, dynamics and mimic the translation reads
@@ -91,12 +89,11 @@ def pose(source: Source, parent) -> Pose:
 
 
 def robot_of(source: Source) -> Robot:
-    """The model of `source.root` (a `<robot>`), and `source.closures` read as joints."""
+    """The model of `source.root` (a `<robot>`)."""
     root = source.root
     materials = tuple(
         _material(source, m) for m in root.iter("material") if m.find("color") is not None
     )
-    source.closures = [joint_of(source, j, deep=False) for j in source.closures]
     return Robot(
         At.of(root),
         root.get("name"),
@@ -105,9 +102,6 @@ def robot_of(source: Source) -> Robot:
         tuple(m for m in materials if m.name),
         tuple(At.of(e) for e in root if isinstance(e.tag, str) and e.tag not in TOP),
     )
-
-
-TOP = ("link", "joint", "material")
 
 
 def link_of(source: Source, element) -> Link:
@@ -159,7 +153,6 @@ def _geometry(source: Source, element, visual: bool) -> Geometry:
         pose(source, element),
         _shape(source, shapes[0]) if shapes else None,
         None if material is None else _material(source, material),
-        element.get(PIECE_OF),
     )
 
 
@@ -178,36 +171,27 @@ def _material(source: Source, element) -> Material:
     return Material(At.of(element), element.get("name"), rgba)
 
 
-def joint_of(source: Source, element, deep: bool = True) -> Joint:
-    """A `<joint>`; `deep` False reads only its name, type and links (a closure)."""
+def joint_of(source: Source, element) -> Joint:
+    """A `<joint>`; its axis, limits, dynamics and mimic only where it moves."""
     ends = [element.find(end) for end in ("parent", "child")]
     parent, child = (None if e is None else e.get("link") for e in ends)
     kind = element.get("type", "")
-    at = At.of(element)
-    if not deep:
-        return Joint(element.get("name"), kind, at, parent, child, listed=element.get("listed"))
     unknown = tuple(
         At.of(e) for e in element if isinstance(e.tag, str) and e.tag not in JOINT_KEEPS
     )
-    joint = Joint(element.get("name"), kind, at, parent, child, pose(source, element))
-    joint = _with(joint, unknown=unknown, listed=element.get("listed"))
-    if kind not in MOVING:
-        return joint
-    axis = None if kind == "spherical" else element.find("axis")  # PyBullet ignores it
-    moving = {
-        "axis": None if axis is None else floats(source, axis, "xyz", 3, "1 0 0"),
-        "axis_at": None if axis is None else At.of(axis),
-        "limit": _limit(source, element.find("limit"), kind),
-        "dynamics": _dynamics(source, element.find("dynamics")),
-        "mimic": _mimic(source, element.find("mimic")),
-    }
-    return _with(joint, **moving)
-
-
-def _with(joint: Joint, **changes) -> Joint:
-    from dataclasses import replace
-
-    return replace(joint, **changes)
+    origin = pose(source, element)  # read before the rest, as the document gives them
+    moving: dict = {}
+    if kind in MOVING:
+        axis = None if kind == "spherical" else element.find("axis")  # PyBullet ignores it
+        moving = {
+            "axis": None if axis is None else floats(source, axis, "xyz", 3, "1 0 0"),
+            "axis_at": None if axis is None else At.of(axis),
+            "limit": _limit(source, element.find("limit"), kind),
+            "dynamics": _dynamics(source, element.find("dynamics")),
+            "mimic": _mimic(source, element.find("mimic")),
+        }
+    at = At.of(element)
+    return Joint(element.get("name"), kind, at, parent, child, origin, unknown=unknown, **moving)
 
 
 def _limit(source: Source, element, kind: str) -> Limit | None:

@@ -13,7 +13,7 @@ Collision meshes that are children of one prim other than the body (a grouping X
 Scope), two or more and each convex, are the convex pieces of one source: a convex
 decomposition its author made, such as the URDF converter's prim for one `<collision>` mesh
 file holding many objects. Each stays its own piece, marked as of that source
-(formats/urdf/model.py `PIECE_OF`), so that they count once against the cap on given collision
+(the model's `Geometry.piece_of`), so that they count once against the cap on given collision
 sources, as the URDF import counts that one file once (it reads the file as one shape, whose
 one convex hull the kit takes; here each piece keeps its own hull, merged pairwise down to
 the kit's ten). A mesh right below the body, or one of a group with a concave mesh, counts
