@@ -13,48 +13,13 @@ import yaml
 
 from simkit.importer import import_robot
 from simkit.importer.read.options import ReadOptions
+from usd_stages import BASE_AND_ARM, stage_text
 
 pytest.importorskip("pxr")
 
 #: a one-joint arm: `base` bolted to the world, `arm` on a revolute joint about Z; OWN is the
 #: joint's own attribute lines, VARIANTS the `Physics` variant set's (or nothing)
-STAGE = """#usda 1.0
-(
-    defaultPrim = "bot"
-    metersPerUnit = {meters}
-    kilogramsPerUnit = 1
-    upAxis = "Z"
-)
-
-def Xform "bot" (
-    prepend apiSchemas = ["PhysicsArticulationRootAPI"]
-    {select}
-)
-{{
-    def Xform "base" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        float physics:mass = 2
-        def Cube "box" (prepend apiSchemas = ["PhysicsCollisionAPI"])
-        {{
-            double size = 0.1
-        }}
-    }}
-    def Xform "arm" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        double3 xformOp:translate = (0, 0, 0.5)
-        uniform token[] xformOpOrder = ["xformOp:translate"]
-        float physics:mass = 1
-        float3 physics:diagonalInertia = (0.01, 0.01, 0.01)
-        def Cube "box" (prepend apiSchemas = ["PhysicsCollisionAPI"])
-        {{
-            double size = 0.1
-        }}
-    }}
-    def PhysicsFixedJoint "world_joint"
-    {{
-        rel physics:body1 = </bot/base>
-    }}
-    def PhysicsRevoluteJoint "hinge"
+HINGE = """    def PhysicsRevoluteJoint "hinge"
     {{
         rel physics:body0 = </bot/base>
         rel physics:body1 = </bot/arm>
@@ -66,7 +31,6 @@ def Xform "bot" (
         {own}
     }}
     {variants}
-}}
 """
 
 MJC = """double mjc:damping = 0.3
@@ -94,14 +58,8 @@ SELECT = """variants = { string Physics = "physx" }
 
 def _usda(tmp_path: Path, own: str = "", variants: bool = False, meters: float = 1.0) -> Path:
     usda = tmp_path / "bot.usda"
-    usda.write_text(
-        STAGE.format(
-            meters=meters,
-            own=own,
-            variants=VARIANTS if variants else "",
-            select=SELECT if variants else "",
-        )
-    )
+    hinge = HINGE.format(own=own, variants=VARIANTS if variants else "")
+    usda.write_text(stage_text(BASE_AND_ARM + hinge, meters, SELECT if variants else ""))
     return usda
 
 

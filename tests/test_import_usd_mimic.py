@@ -14,48 +14,19 @@ import pytest
 import yaml
 
 from simkit.importer import import_robot
+from usd_stages import body_text, bolted_text, stage_text
 
 pytest.importorskip("pxr")
 
 #: a palm bolted to the world with two fingers on KIND joints about Y (`left` the leader,
 #: `right` the follower); SCHEMAS is the follower's apiSchemas, MIMIC its mimic attributes
-STAGE = """#usda 1.0
-(
-    defaultPrim = "bot"
-    metersPerUnit = {meters}
-    kilogramsPerUnit = 1
-    upAxis = "Z"
+FINGERS = (
+    body_text("palm", 2)
+    + body_text("left_link", 0.1, at=(0, 0.3, 0.2), inertia=(0.001,) * 3, box=False)
+    + body_text("right_link", 0.1, at=(0, -0.3, 0.2), inertia=(0.001,) * 3, box=False)
+    + bolted_text("palm")
 )
-
-def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"])
-{{
-    def Xform "palm" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        float physics:mass = 2
-        def Cube "box" (prepend apiSchemas = ["PhysicsCollisionAPI"])
-        {{
-            double size = 0.1
-        }}
-    }}
-    def Xform "left_link" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        double3 xformOp:translate = (0, 0.3, 0.2)
-        uniform token[] xformOpOrder = ["xformOp:translate"]
-        float physics:mass = 0.1
-        float3 physics:diagonalInertia = (0.001, 0.001, 0.001)
-    }}
-    def Xform "right_link" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        double3 xformOp:translate = (0, -0.3, 0.2)
-        uniform token[] xformOpOrder = ["xformOp:translate"]
-        float physics:mass = 0.1
-        float3 physics:diagonalInertia = (0.001, 0.001, 0.001)
-    }}
-    def PhysicsFixedJoint "world_joint"
-    {{
-        rel physics:body1 = </bot/palm>
-    }}
-    def Physics{kind}Joint "left"
+JOINTS = """    def Physics{kind}Joint "left"
     {{
         rel physics:body0 = </bot/palm>
         rel physics:body1 = </bot/left_link>
@@ -74,7 +45,6 @@ def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"])
         float physics:upperLimit = 90
         {mimic}
     }}
-}}
 """
 
 NEWTON = """prepend rel newton:mimicJoint = </bot/left>
@@ -90,7 +60,8 @@ def _joints(tmp_path: Path, schemas: str, mimic: str, kind: str = "Revolute", me
     """(the imported spec's joints by name, the import's report lines)."""
     tmp_path.mkdir(parents=True, exist_ok=True)
     usda = tmp_path / "bot.usda"
-    usda.write_text(STAGE.format(meters=meters, kind=kind, schemas=schemas, mimic=mimic))
+    text = JOINTS.format(kind=kind, schemas=schemas, mimic=mimic)
+    usda.write_text(stage_text(FINGERS + text, meters))
     done = import_robot(usda, tmp_path / "out")
     joints = {j["name"]: j for j in yaml.safe_load(done.spec_path.read_text())["joints"]}
     return joints, done.lines

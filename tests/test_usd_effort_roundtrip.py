@@ -15,44 +15,13 @@ import yaml
 from simkit.emit.usd.physics import EFFORT_LIMIT
 from simkit.importer import import_robot
 from simkit.importer.formats.usd.limits import EFFORT_LIMIT as READ_EFFORT_LIMIT
+from usd_stages import BASE_AND_ARM, stage_text
 
 pytest.importorskip("pxr")
 
 #: a one-joint arm: `base` bolted to the world, `arm` on a revolute joint about Z whose drive
 #: has maxForce 56.4 N m; EFFORT is replaced by the joint's effort attribute line (or nothing)
-STAGE = """#usda 1.0
-(
-    defaultPrim = "bot"
-    metersPerUnit = {meters}
-    upAxis = "Z"
-)
-
-def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"])
-{{
-    def Xform "base" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        float physics:mass = 2
-        def Cube "box" (prepend apiSchemas = ["PhysicsCollisionAPI"])
-        {{
-            double size = 0.1
-        }}
-    }}
-    def Xform "arm" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])
-    {{
-        double3 xformOp:translate = (0, 0, 0.5)
-        uniform token[] xformOpOrder = ["xformOp:translate"]
-        float physics:mass = 1
-        float3 physics:diagonalInertia = (0.01, 0.01, 0.01)
-        def Cube "box" (prepend apiSchemas = ["PhysicsCollisionAPI"])
-        {{
-            double size = 0.1
-        }}
-    }}
-    def PhysicsFixedJoint "world_joint"
-    {{
-        rel physics:body1 = </bot/base>
-    }}
-    def PhysicsRevoluteJoint "hinge" (prepend apiSchemas = ["PhysicsDriveAPI:angular"])
+HINGE = """    def PhysicsRevoluteJoint "hinge" (prepend apiSchemas = ["PhysicsDriveAPI:angular"])
     {{
         rel physics:body0 = </bot/base>
         rel physics:body1 = </bot/arm>
@@ -63,14 +32,13 @@ def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"])
         float drive:angular:physics:maxForce = 56.4
         {effort}
     }}
-}}
 """
 
 
 def _hinge(tmp_path: Path, effort_line: str, meters: float = 1.0) -> dict:
     """The imported spec's hinge joint."""
     usda = tmp_path / "bot.usda"
-    usda.write_text(STAGE.format(meters=meters, effort=effort_line))
+    usda.write_text(stage_text(BASE_AND_ARM + HINGE.format(effort=effort_line), meters))
     done = import_robot(usda, tmp_path / "out")
     joints = {j["name"]: j for j in yaml.safe_load(done.spec_path.read_text())["joints"]}
     return joints["hinge"]

@@ -131,3 +131,56 @@ def _variant(stage, prim, upper: str) -> None:
         with variants.GetVariantEditContext():
             UsdPhysics.MassAPI(stage.GetPrimAtPath(upper)).GetMassAttr().Set(mass)
     variants.SetVariantSelection("light")
+
+
+def stage_text(inside: str, meters: float = 1.0, root_metadata: str = "") -> str:
+    """A small stage as usda text (for schemas usd-core does not register, written by name):
+    Z-up, `metersPerUnit` `meters`, and the articulation root `bot` holding `inside` (prims
+    indented four spaces); `root_metadata` adds lines to `bot`'s metadata (a variant
+    selection)."""
+    meta = f"\n    {root_metadata}\n" if root_metadata else ""
+    return (
+        f'#usda 1.0\n(\n    defaultPrim = "bot"\n    metersPerUnit = {meters}\n'
+        f'    kilogramsPerUnit = 1\n    upAxis = "Z"\n)\n\n'
+        f'def Xform "bot" (prepend apiSchemas = ["PhysicsArticulationRootAPI"]{meta})\n'
+        f"{{\n{inside}}}\n"
+    )
+
+
+def body_text(name: str, mass: float, at=None, inertia=None, box: bool = True) -> str:
+    """A rigid body prim `name` (MassAPI `mass` kg, at `at` (m) and with `inertia` (kg m^2)
+    where given), with a 0.1 m collision cube when `box`."""
+    lines = [
+        f'    def Xform "{name}" (prepend apiSchemas = ["PhysicsRigidBodyAPI", "PhysicsMassAPI"])'
+    ]
+    lines.append("    {")
+    if at is not None:
+        lines.append(f"        double3 xformOp:translate = ({', '.join(f'{v:g}' for v in at)})")
+        lines.append('        uniform token[] xformOpOrder = ["xformOp:translate"]')
+    lines.append(f"        float physics:mass = {mass:g}")
+    if inertia is not None:
+        lines.append(
+            f"        float3 physics:diagonalInertia = ({', '.join(f'{v:g}' for v in inertia)})"
+        )
+    if box:
+        lines += [
+            '        def Cube "box" (prepend apiSchemas = ["PhysicsCollisionAPI"])',
+            "        {",
+            "            double size = 0.1",
+            "        }",
+        ]
+    return "\n".join([*lines, "    }", ""])
+
+
+def bolted_text(body: str) -> str:
+    """A fixed joint `world_joint` holding `body` to the world."""
+    joint = '    def PhysicsFixedJoint "world_joint"\n    {\n'
+    return f"{joint}        rel physics:body1 = </bot/{body}>\n    }}\n"
+
+
+#: the base bolted to the world and the arm 0.5 m above it, for a hinge between them
+BASE_AND_ARM = (
+    body_text("base", 2)
+    + body_text("arm", 1, at=(0, 0, 0.5), inertia=(0.01, 0.01, 0.01))
+    + bolted_text("base")
+)
