@@ -111,3 +111,13 @@ def test_translation_reads_only_the_model(tmp_path):
     assert joints["shoulder"]["lower"] == -1.5 and joints["shoulder"]["damping"] == 0.1
     assert joints["grip"]["mimic"] == {"joint": "shoulder", "multiplier": 0.01, "offset": 0.02}
     assert [link["name"] for link in draft.spec["links"]] == ["base", "arm", "finger"]
+
+
+def test_document_keeps_a_name_that_reads_none(tmp_path):
+    """A link or joint named "None" keeps its name in the written document (only a value
+    the model does not hold is left out)."""
+    text = URDF.replace('name="finger"', 'name="None"').replace('link="finger"', 'link="None"')
+    source, _ = _read(tmp_path, text)
+    written = document(source.robot)
+    assert [link.get("name") for link in written.findall("link")][-1] == "None"
+    assert robot_of(replace(source, root=written, closures=[])) == source.robot
